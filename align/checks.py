@@ -1,0 +1,177 @@
+"""Checks that turn a bad rate-table test into a clear error.
+
+Each check either passes (returning a :class:`Check` to show in the result) or
+raises :class:`~align.errors.TestError` naming the segment or step and what to
+do. They assume the gyro axes are nominally aligned with the system axes (the
+misalignment being measured is a few degrees, not a re-mounted IMU).
+
+Public names
+------------
+Check, check_log, check_span, check_saturation, check_durations,
+check_directions, check_scale, check_residuals
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import HandednessError, InputError, TestError
+from .plan import Plan, axis_name
+from .segment import Segment
+from .units import format_quantity, unit_mixup_hint
+
+
+@dataclass(frozen=True)
+class Check:
+    """One check's outcome: ``status`` is ``"pass"`` or ``"warn"``."""
+
+    name: str
+    status: str
+    detail: str
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "status": self.status, "detail": self.detail}
+
+
+def check_log(t: np.ndarray, g: np.ndarray, where: str, min_rows: int = 10) -> None:
+    """Reject NaN or infinite rows, non-increasing time and logs that are too short."""
+    if len(t) < min_rows:
+        raise InputError(f"only {len(t)} rows; a session needs at least {min_rows}", where)
+    bad = ~np.isfinite(g).all(axis=1) | ~np.isfinite(t)
+    if bad.any():
+        rows = np.flatnonzero(bad)
+        raise InputError(f"{len(rows)} rows with NaN or inf (first at data row {rows[0] + 1}); remove or repair them", where)
+    dt = np.diff(t)
+    if np.any(dt <= 0):
+        k = int(np.argmax(dt <= 0))
+        raise InputError(f"time does not increase at data row {k + 2} (t={t[k + 1]!r} after {t[k]!r}); sort the log or fix the time column", where)
+
+
+def check_span(plan: Plan, allow_two_axis: bool = False) -> int | None:
+    """The plan must turn about three independent axes (two for the shortcut).
+
+    Returns
+    -------
+    int or None
+        The axis never turned about, when ``allow_two_axis`` and exactly one is missing.
+    """
+    turned = plan.axes_turned()
+    missing = [a for a in range(3) if a not in turned]
+    if not missing:
+        return None
+    names = ", ".join(axis_name(a)[1] for a in sorted(turned))
+    if allow_two_axis and len(missing) == 1:
+        return missing[0]
+    hint = "add steps about it or use --method two-axis (assumes orthogonal gyros)" if len(missing) == 1 else "add steps about them"
+    raise TestError(
+        f"the rotations do not span 3-D: the plan turns about {names} only, never about "
+        f"{', '.join(axis_name(a)[1] for a in missing)}; {hint}",
+        "plan",
+    )
+
+
+def check_saturation(g: np.ndarray, segments: list[Segment], gyro_range: float | None, units: str) -> Check:
+    """No sample used in a segment may reach 99 % of the stated gyro range."""
+    if gyro_range is None:
+        return Check("saturation", "pass", "no gyro range stated (--gyro-range)")
+    limit = 0.99 * gyro_range
+    for seg in segments:
+        peak = float(np.max(np.abs(g[seg.start : seg.end])))
+        if peak >= limit:
+            raise TestError(
+                f"reaches {format_quantity(peak, units, 5)}, at the gyro range {format_quantity(gyro_range, units, 5)}: "
+                "the gyro saturated; lower the table rate",
+                seg.name,
+            )
+    return Check("saturation", "pass", f"all segments below 99 % of {format_quantity(gyro_range, units, 5)}")
+
+
+def check_durations(segments: list[Segment], fs: float, min_duration: float, min_samples: int = 10) -> Check:
+    """Every step segment must last at least ``min_duration`` seconds and ``min_samples`` samples."""
+    for seg in segments:
+        if seg.kind == "static":
+            continue
+        if seg.n < min_samples or seg.n / fs < min_duration:
+            raise TestError(
+                f"lasts {seg.n / fs:.3g} s ({seg.n} samples), shorter than the {min_duration:g} s minimum; "
+                "dwell longer at this step (or lower --min-dwell)",
+                seg.name,
+            )
+    return Check("durations", "pass", f"every step at least {min_duration:g} s")
+
+
+def check_directions(measured: list[tuple[Segment, float, float]], plan: Plan, tolerance: float, units: str) -> Check:
+    """Compare each step's measured turn with the plan.
+
+    Parameters
+    ----------
+    measured : list of (Segment, along, across)
+        Per step: the measured rate (rad/s) or angle (rad) along the planned
+        spin axis, and the size of the part across it (bias removed where known).
+    plan : Plan
+    tolerance : float
+        Largest relative difference from the planned rate or angle.
+    units : str
+        Display unit of rates (angles are shown in deg).
+    """
+    steps = [plan.steps[seg.step] for seg, _, _ in measured]
+    planned = np.array([s.rate if s.rate is not None else s.angle for s in steps])
+    ratios = np.array([along for _, along, _ in measured]) / planned
+    signed = planned * np.array([s.sign for s in steps])  # turn about the positive system axis
+    hint = unit_mixup_hint(float(np.median(np.abs(ratios))))
+    if hint:
+        raise TestError(hint, "log")
+    for axis in range(3):
+        on = np.array([s.axis == axis for s in steps])
+        if len(set(np.sign(signed[on]))) == 2 and np.all(ratios[on] < 0):
+            raise HandednessError(
+                f"every step about {'xyz'[axis]}, in both directions, measured reversed: the {'xyz'[axis]} gyro reads "
+                "backwards (det(M) < 0, a handedness error) or the plan's axis signs are wrong; fix the wiring or sign, "
+                "the tool does not flip it",
+                "log",
+            )
+    for (seg, along, across), ratio, step, value in zip(measured, ratios, steps, planned):
+        unit = units if step.rate is not None else "deg"
+        said = f"planned {format_quantity(value, unit, 5)} about {axis_name(step.axis, step.sign)}, measured {format_quantity(along, unit, 5)}"
+        if ratio < 0:
+            raise TestError(f"{said}: the table turned the wrong way; re-run the step or correct its sign in the plan", seg.name)
+        if abs(across) > 0.5 * abs(along):
+            raise TestError(
+                f"{said} and {format_quantity(across, unit, 5)} across that axis: the table turned about another axis; "
+                "check the fixture orientation and the step's axis",
+                seg.name,
+            )
+        if abs(ratio - 1) > tolerance:
+            what = "rate" if step.rate is not None else "angle"
+            raise TestError(
+                f"{said}: off by {100 * (ratio - 1):+.1f} % (tolerance {100 * tolerance:g} %); wrong table {what} or wrong plan step",
+                seg.name,
+            )
+    return Check("directions", "pass", f"every step within {100 * tolerance:g} % of the plan, in the planned direction")
+
+
+def check_scale(m: np.ndarray, tolerance: float) -> Check:
+    """Scale factors ``|M[i, :]|`` must lie within ``1 +/- tolerance``."""
+    scale = np.linalg.norm(m, axis=1)
+    for i, s in enumerate(scale):
+        if not abs(s - 1.0) <= tolerance:
+            raise TestError(
+                f"gyro {'xyz'[i]} scale factor {s:.4f} is outside 1 +/- {tolerance:g}: wrong gyro units, "
+                "wrong table rate, or a broken gyro (raise --scale-tolerance if this is expected)",
+                "result",
+            )
+    return Check("scale", "pass", f"scale factors {', '.join(f'{s:.5f}' for s in scale)} within 1 +/- {tolerance:g}")
+
+
+def check_residuals(segments: list[Segment], rms: np.ndarray, expected: np.ndarray, units: str) -> Check:
+    """Warn (not fail) about segments whose residual is over 5x what their noise explains."""
+    ratio = rms / np.maximum(expected, 1e-300)
+    worst = int(np.argmax(ratio)) if len(ratio) else 0
+    if len(ratio) and ratio[worst] > 5:
+        return Check("residuals", "warn",
+                     f"{segments[worst].name}: residual {ratio[worst]:.1f}x its noise; bias drift or a table error? "
+                     "inspect the segment table")
+    return Check("residuals", "pass", "every segment's residual within 5x its noise")
+

@@ -1,0 +1,222 @@
+"""The ``imu-align`` command line: a thin layer over the library.
+
+Each command parses its options (units at this edge), calls the library,
+prints a summary and writes its files only after everything succeeded. A
+user-facing problem is one line on stderr and a non-zero exit status
+(2: bad input, 3: the test does not support a result); set
+``IMU_ALIGN_DEBUG=1`` to see the traceback of an unexpected failure.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    help="MEMS IMU mounting-misalignment analysis and electronic alignment.\n\n"
+    "Convention everywhere: g = M w + b, w = A (g - b), A = M^-1; rows of M are gyros.",
+)
+
+DEFAULT_COLUMNS = "time,gyro_x,gyro_y,gyro_z"
+
+
+def _columns(text: str, rate_hz: Optional[float]) -> tuple[Optional[str], list[str]]:
+    names = [c.strip() for c in text.split(",") if c.strip()]
+    if rate_hz is None:
+        if len(names) != 4:
+            from .errors import InputError
+
+            raise InputError("give four names: time,x,y,z (or three with --rate-hz)", "--columns")
+        return names[0], names[1:]
+    return None, names[-3:]
+
+
+@app.command()
+def matrix(
+    log: Path = typer.Argument(..., help="Gyro log: .csv, .csv.gz, .npy or .parquet."),
+    plan: Path = typer.Option(..., "--plan", help="Test plan TOML: [[step]] axis, rate or angle."),
+    method: str = typer.Option("auto", help="auto | rate | angle | lsq | two-axis."),
+    gyro_units: str = typer.Option("deg/s", help="Unit of the gyro columns, e.g. deg/s, rad/s, mdps."),
+    columns: str = typer.Option(DEFAULT_COLUMNS, help="Column names: time,x,y,z (x,y,z with --rate-hz)."),
+    rate_hz: Optional[float] = typer.Option(None, help="Sample rate for a log without a time column."),
+    segments: Optional[Path] = typer.Option(None, help="Explicit segments JSON {name: {start, end}} instead of automatic."),
+    json_out: Optional[Path] = typer.Option(None, "--json", help="Write the versioned JSON result here."),
+    c_header: Optional[Path] = typer.Option(None, "--c-header", help="Write A and the bias as a C header here."),
+    gyro_range: Optional[str] = typer.Option(None, help="Gyro full scale, e.g. '2000 deg/s': flags saturation."),
+    min_dwell: str = typer.Option("1 s", help="Shortest acceptable step."),
+    window: str = typer.Option("0.1 s", help="Moving-mean window of the segmentation."),
+    margin: str = typer.Option("0.1 s", help="Trimmed from each end of a dwell beyond the ramp."),
+    static_threshold: str = typer.Option("1 deg/s", help="Static periods lie within this of the quietest one (angle plans)."),
+    rate_tolerance: str = typer.Option("10 %", help="Largest difference of a measured turn from the plan."),
+    scale_tolerance: str = typer.Option("5 %", help="Scale factors must lie within 1 +/- this."),
+    axis_to_axis: str = typer.Option("0.05 deg", help="Axis-to-axis spec for the two-axis shortcut's error."),
+    two_axis_variant: str = typer.Option("procrustes", help="procrustes | cross (the source's Eq 36)."),
+    earth: bool = typer.Option(True, help="Correct the vertical Earth rate when the plan gives a latitude."),
+) -> None:
+    """Alignment matrix M and A = M^-1 from rate-table data."""
+    from . import fileio
+    from .alignment import AlignOptions, align
+    from .plan import Plan
+    from .segment import SegmentOptions, segments_from_ranges
+    from .summary import alignment_summary
+    from .units import parse_quantity as q
+
+    if two_axis_variant not in ("procrustes", "cross"):
+        from .errors import InputError
+
+        raise InputError("choose procrustes or cross", "--two-axis-variant")
+    time_col, cols = _columns(columns, rate_hz)
+    the_plan = Plan.from_dict(fileio.read_toml(plan), str(plan))
+    t, g = fileio.read_log(log, cols, gyro_units, time_col, rate_hz)
+    opts = AlignOptions(
+        method=method,
+        two_axis_variant=two_axis_variant,
+        axis_to_axis=q(axis_to_axis, "angle", "--axis-to-axis"),
+        segmentation=SegmentOptions(
+            window_s=q(window, "time", "--window"),
+            margin_s=q(margin, "time", "--margin"),
+            static_threshold=q(static_threshold, "angular_rate", "--static-threshold"),
+        ),
+        min_dwell=q(min_dwell, "time", "--min-dwell"),
+        rate_tolerance=q(rate_tolerance, "dimensionless", "--rate-tolerance"),
+        scale_tolerance=q(scale_tolerance, "dimensionless", "--scale-tolerance"),
+        gyro_range=None if gyro_range is None else q(gyro_range, "angular_rate", "--gyro-range"),
+        earth_correction=earth,
+    )
+    segs = None
+    if segments is not None:
+        segs = segments_from_ranges(fileio.read_json(segments), the_plan, len(t), str(segments))
+    result = align(t, g, the_plan, opts, segs, gyro_units, str(log))
+    inputs = {"log": str(log), "plan": str(plan), "gyro_units": gyro_units, "columns": columns,
+              "segments": None if segments is None else str(segments)}
+    result = type(result)(**{**result.__dict__, "inputs": inputs})
+    typer.echo(alignment_summary(result))
+    if json_out is not None:
+        fileio.write_json(json_out, result.to_dict())
+    if c_header is not None:
+        from . import CONVENTION
+        from .units import to_unit
+
+        text = fileio.c_header("IMU_ALIGN", result.A, to_unit(result.bias, gyro_units), gyro_units,
+                               f"imu-align alignment from {log.name}\n{CONVENTION}")
+        fileio.write_text(c_header, text)
+
+
+@app.command()
+def apply(
+    log: Path = typer.Argument(..., help="Log to correct."),
+    alignment: Path = typer.Option(..., "--alignment", help="Result JSON from 'imu-align matrix'."),
+    out: Path = typer.Option(..., "--out", help="Corrected CSV (same columns and units)."),
+    gyro_units: str = typer.Option("deg/s", help="Unit of the gyro columns."),
+    columns: str = typer.Option(DEFAULT_COLUMNS, help="Column names: time,x,y,z (x,y,z with --rate-hz)."),
+    rate_hz: Optional[float] = typer.Option(None, help="Sample rate for a log without a time column."),
+) -> None:
+    """Correct a log: w = A (g - b), written in the log's own units."""
+    import numpy as np
+
+    from . import fileio
+    from .alignment import AlignmentResult
+    from .model import SensorModel
+    from .units import to_unit
+
+    result = AlignmentResult.from_dict(fileio.read_json(alignment), str(alignment))
+    time_col, cols = _columns(columns, rate_hz)
+    t, g = fileio.read_log(log, cols, gyro_units, time_col, rate_hz)
+    w = SensorModel(result.M, result.bias).correct(g)
+    names = ([time_col] if time_col else []) + cols
+    data = np.column_stack(([t] if time_col else []) + [to_unit(w, gyro_units)])
+    fileio.write_csv(out, names, data)
+    typer.echo(f"wrote {out}: {len(t)} rows corrected with A from {alignment} (w = A (g - b), {gyro_units})")
+
+
+@app.command()
+def simulate(
+    out_dir: Path = typer.Argument(..., help="Folder for session.csv, plan.toml and truth.json."),
+    plan: Optional[Path] = typer.Option(None, "--plan", help="Plan to run; default the six-dwell +/- rate plan."),
+    kind: str = typer.Option("rate", help="rate | angle: the default plan's kind."),
+    rate: str = typer.Option("100 deg/s", help="Table rate of the default rate plan."),
+    angle: str = typer.Option("360 deg", help="Turn of the default angle plan."),
+    fs: str = typer.Option("200 Hz", help="Sample rate."),
+    dwell: str = typer.Option("10 s", help="Constant-rate part of each rate step."),
+    gap: str = typer.Option("3 s", help="Static gap between steps."),
+    noise: str = typer.Option("0.3 deg/sqrt(h)", help="Angle random walk (white rate noise)."),
+    bias_walk: str = typer.Option("0 deg/h/sqrt(h)", help="Rate random walk of the bias."),
+    misalignment: str = typer.Option("0.5 deg", help="Size of the random mounting rotation."),
+    seed: int = typer.Option(0, help="Random seed."),
+    gyro_units: str = typer.Option("deg/s", help="Unit of the written gyro columns."),
+) -> None:
+    """Simulate a rate-table session with known M (for rehearsals and examples)."""
+    import numpy as np
+    from scipy.spatial.transform import Rotation
+
+    from . import CONVENTION, fileio
+    from .errors import InputError
+    from .model import SensorModel
+    from .plan import Plan
+    from .simulate import SessionSpec, simulate_session
+    from .units import DEG, to_unit
+    from .units import parse_quantity as q
+
+    if not out_dir.is_dir():
+        raise InputError("output folder does not exist", str(out_dir))
+    if plan is not None:
+        the_plan = Plan.from_dict(fileio.read_toml(plan), str(plan))
+    elif kind == "rate":
+        the_plan = Plan.standard_rate(q(rate, "angular_rate", "--rate"))
+    elif kind == "angle":
+        the_plan = Plan.standard_angle(q(angle, "angle", "--angle"))
+    else:
+        raise InputError("choose rate or angle", "--kind")
+    rng = np.random.default_rng(seed)
+    size = q(misalignment, "angle", "--misalignment")
+    rotvec = rng.normal(size=3)
+    rotvec *= size / np.linalg.norm(rotvec)
+    truth = SensorModel.from_rotation(
+        Rotation.from_rotvec(rotvec), scale=1 + rng.normal(0, 2e-3, 3), delta=rng.normal(0, 0.05 * DEG, 3),
+        bias=rng.normal(0, 0.2 * DEG, 3),
+    )
+    spec = SessionSpec(fs=q(fs, "frequency", "--fs"), dwell_s=q(dwell, "time", "--dwell"), static_s=q(gap, "time", "--gap"),
+                       noise_density=q(noise, "angle_random_walk", "--noise"),
+                       bias_walk=q(bias_walk, "rate_random_walk", "--bias-walk"))
+    t, g, _ = simulate_session(the_plan, truth, spec, rng)
+    fileio.write_csv(out_dir / "session.csv", DEFAULT_COLUMNS.split(","), np.column_stack([t, to_unit(g, gyro_units)]))
+    fileio.write_text(out_dir / "plan.toml", the_plan.to_toml())
+    fileio.write_json(out_dir / "truth.json", {
+        "format": "imu-align.truth", "version": 1, "convention": CONVENTION,
+        "units": {"M": "1", "bias": gyro_units}, "M": truth.M, "A": truth.alignment(),
+        "bias": to_unit(truth.bias, gyro_units), "seed": seed,
+    })
+    typer.echo(f"wrote {out_dir}/session.csv ({len(t)} rows, {t[-1]:.1f} s), plan.toml and truth.json")
+
+
+def main() -> None:
+    """Entry point: run the app, turning user-facing errors into one line and an exit code."""
+    from .errors import AlignError
+
+    try:
+        app(standalone_mode=False)
+    except AlignError as exc:
+        typer.echo(f"imu-align: error: {exc}", err=True)
+        sys.exit(exc.exit_code)
+    except Exception as exc:  # click's usage errors and unexpected failures
+        import click
+
+        if isinstance(exc, click.exceptions.ClickException):
+            exc.show()
+            sys.exit(exc.exit_code)
+        if isinstance(exc, click.exceptions.Abort):
+            sys.exit(130)
+        if os.environ.get("IMU_ALIGN_DEBUG"):
+            raise
+        typer.echo(f"imu-align: internal error: {type(exc).__name__}: {exc} (set IMU_ALIGN_DEBUG=1 for details)", err=True)
+        sys.exit(1)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,339 @@
+"""Estimators of ``[M | b]`` from rate-table segments.
+
+Every segment becomes one linear observation of all three gyros,
+``y_k = [M | b] phi_k``:
+
+* constant-rate dwell (Eq 19-30): ``y`` = mean reading, ``phi = [w_k; 1]``;
+* turn of known angle (Eq 31, integrated Eq 11-13): ``y`` = integrated reading,
+  ``phi = [theta_k u_k; T_k]`` (``T_k`` the duration, so a bias adds ``b T_k``);
+* static period: ``y`` = mean reading, ``phi = [w_earth; 1]`` (``[0; 1]`` without
+  an Earth-rate correction).
+
+:func:`fit_lsq` is the general weighted least squares over any set of segments
+(any axes, rates, lengths); :func:`fit_rate_pairs` (Eq 28-30) and
+:func:`fit_angle_pairs` (Eq 31) are the closed forms of the source, which it
+reproduces on their designs; :func:`two_axis` is the orthogonal shortcut
+(Eq 35-36).
+
+Public names
+------------
+Observation, Fit, observe, fit_lsq, fit_rate_pairs, fit_angle_pairs, two_axis,
+two_axis_error_bound, alignment_sigma
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .earth import vertical_rate
+from .errors import TestError
+from .model import nearest_rotation
+from .plan import Plan, axis_name
+from .segment import Segment, integrate
+
+
+@dataclass(frozen=True)
+class Observation:
+    """One segment as a linear observation ``y = [M | b] phi`` (SI units).
+
+    ``var`` is the variance of each component of ``y`` from the noise inside
+    the segment (batch means for dwells, white noise for turns).
+    """
+
+    segment: Segment
+    y: np.ndarray
+    phi: np.ndarray
+    var: np.ndarray
+    duration: float
+
+
+@dataclass(frozen=True)
+class Fit:
+    """Estimated ``M`` and ``b`` with their 1-sigma uncertainties.
+
+    Attributes
+    ----------
+    M, sigma_M : ndarray, shape (3, 3)
+    bias, sigma_bias : ndarray, shape (3,)
+        rad/s.
+    cov : ndarray, shape (3, 4, 4)
+        Covariance of each row ``[M_i1, M_i2, M_i3, b_i]``.
+    residuals : ndarray, shape (k, 3)
+        ``y - [M | b] phi`` per observation, rad/s for dwells, rad for turns.
+    dof : int
+        Observations minus parameters, per gyro.
+    chi2 : ndarray, shape (3,)
+        Weighted residual sum of squares per gyro.
+    condition_number : float
+        Of the column-normalised design matrix.
+    method : str
+    """
+
+    M: np.ndarray
+    bias: np.ndarray
+    sigma_M: np.ndarray
+    sigma_bias: np.ndarray
+    cov: np.ndarray
+    residuals: np.ndarray
+    dof: int
+    chi2: np.ndarray
+    condition_number: float
+    method: str
+
+
+#: smallest variance of an observation ((rad/s)^2 or rad^2): keeps noiseless data finite
+_VAR_FLOOR = 1e-30
+
+
+def _batch_mean_var(x: np.ndarray, batches: int = 10) -> np.ndarray:
+    """Variance of the mean of ``x`` (n, 3) by batch means: robust to short-term correlation."""
+    n = len(x)
+    if n < 4 * batches:
+        return np.var(x, axis=0, ddof=1) / n
+    m = n // batches
+    means = x[: m * batches].reshape(batches, m, 3).mean(axis=1)
+    return np.var(means, axis=0, ddof=1) / batches
+
+
+def observe(t: np.ndarray, g: np.ndarray, segments: list[Segment], plan: Plan, sigma: np.ndarray, earth: bool = False) -> list[Observation]:
+    """Turn segments into linear observations (see module docstring).
+
+    Parameters
+    ----------
+    t, g : ndarray
+        Time (s) and gyro readings (rad/s), shapes (n,) and (n, 3).
+    segments : list of Segment
+    plan : Plan
+    sigma : ndarray, shape (3,)
+        Per-sample white-noise sigma, rad/s (for the variance of turns).
+    earth : bool
+        Add the vertical Earth rate along the table axis (needs ``plan.latitude``);
+        it is then modelled in ``w`` instead of ending in the bias.
+    """
+    dt = float(np.median(np.diff(t)))
+    e_up = vertical_rate(plan.latitude) if earth and plan.latitude is not None else 0.0
+    out = []
+    for seg in segments:
+        x = g[seg.start : seg.end]
+        if seg.kind == "angle":
+            step = plan.steps[seg.step]
+            y, duration = integrate(t, g, seg.start, seg.end)
+            phi = np.append((step.angle + e_up * duration) * step.unit_axis, duration)
+            var = sigma**2 * dt * duration
+        else:
+            duration = seg.n * dt
+            y = x.mean(axis=0)
+            if seg.kind == "rate":
+                step = plan.steps[seg.step]
+                phi = np.append((step.rate + e_up) * step.unit_axis, 1.0)
+            else:
+                phi = np.array([0.0, 0.0, 0.0, 1.0])
+            var = np.maximum(_batch_mean_var(x), sigma**2 / seg.n)
+        out.append(Observation(seg, y, phi, np.maximum(var, _VAR_FLOOR), duration))
+    return out
+
+
+def _design(obs: list[Observation]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    phi = np.array([o.phi for o in obs])
+    y = np.array([o.y for o in obs])
+    var = np.array([o.var for o in obs])
+    return phi, y, var
+
+
+def condition_number(phi: np.ndarray) -> float:
+    """Condition number of the design with each column scaled to unit norm."""
+    norms = np.linalg.norm(phi, axis=0)
+    norms[norms == 0] = 1.0
+    s = np.linalg.svd(phi / norms, compute_uv=False)
+    return float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
+
+
+def fit_lsq(obs: list[Observation], rate_accuracy: float = 0.0, method: str = "lsq") -> Fit:
+    """General weighted least squares for ``[M | b]`` (extends Eq 28-31).
+
+    Each gyro ``i`` is fitted separately: minimise
+    ``sum_k (y_ki - phi_k . x_i)^2 / var_ki``. The covariance is
+    ``(Phi^T W Phi)^-1``, inflated by ``chi2 / dof`` when that exceeds 1 (the
+    scatter between segments is larger than the noise inside them, e.g. bias
+    drift); a stated table rate accuracy adds ``(M_ij rate_accuracy)^2``.
+
+    Columns of ``M`` for axes never turned about are left NaN (the two-axis
+    shortcut fills them).
+
+    Raises
+    ------
+    TestError
+        When the segments do not determine the turned columns and ``b``.
+    """
+    phi, y, var = _design(obs)
+    k = len(obs)
+    active = np.flatnonzero(np.linalg.norm(phi, axis=0) > 0)
+    if np.linalg.matrix_rank(phi[:, active] / np.linalg.norm(phi[:, active], axis=0)) < len(active) or 3 not in active:
+        raise TestError(
+            "the segments do not determine M and the bias together: "
+            "turn about each axis and add +/- pairs or static periods"
+        )
+    x = np.full((3, 4), np.nan)
+    cov = np.full((3, 4, 4), np.nan)
+    chi2 = np.empty(3)
+    resid = np.empty((k, 3))
+    dof = k - len(active)
+    sub = np.ix_(active, active)
+    for i in range(3):
+        wts = 1.0 / var[:, i]
+        a = phi[:, active] * np.sqrt(wts)[:, None]
+        b = y[:, i] * np.sqrt(wts)
+        sol, *_ = np.linalg.lstsq(a, b, rcond=None)
+        x[i, active] = sol
+        resid[:, i] = y[:, i] - phi[:, active] @ sol
+        chi2[i] = float(np.sum(resid[:, i] ** 2 * wts))
+        inflate = max(1.0, chi2[i] / dof) if dof > 0 else 1.0
+        cov[i][sub] = np.linalg.inv(a.T @ a) * inflate
+    m = x[:, :3]
+    if rate_accuracy:
+        for i in range(3):
+            cov[i, :3, :3] += np.diag(np.nan_to_num(m[i] * rate_accuracy) ** 2)
+    sig = np.sqrt(np.einsum("ijj->ij", cov))
+    return Fit(m, x[:, 3], sig[:, :3], sig[:, 3], cov, resid, dof, chi2, condition_number(phi[:, active]), method)
+
+
+def _pairs(obs: list[Observation], plan: Plan, kind: str) -> dict[int, tuple[Observation, Observation]]:
+    """For each axis, the observation with positive and negative turn (Eq 28, 31)."""
+    found: dict[int, dict[int, Observation]] = {}
+    for o in obs:
+        if o.segment.kind != kind:
+            continue
+        step = plan.steps[o.segment.step]
+        value = step.rate if kind == "rate" else step.angle
+        found.setdefault(step.axis, {})[int(np.sign(value * step.sign))] = o
+    pairs = {a: (d[1], d[-1]) for a, d in found.items() if 1 in d and -1 in d}
+    missing = [axis_name(a) for a in range(3) if a not in pairs]
+    if missing:
+        raise TestError(f"the {kind} method needs one +{kind} and one -{kind} step about each axis; none complete about {', '.join(missing)} (use --method lsq)")
+    return pairs
+
+
+def fit_rate_pairs(obs: list[Observation], plan: Plan) -> Fit:
+    """Eq 28-30: ``M_ij = (g_i(+) - g_i(-)) / (w(+) - w(-))``, ``b = mean of (g(+) + g(-)) / 2``.
+
+    With the table turning at ``+w`` and ``-w`` this is the source's
+    ``(g(+) - g(-)) / (2 w)``; the bias is the average over the three pairs of
+    the pairwise bias, assuming equal rates.
+    """
+    pairs = _pairs(obs, plan, "rate")
+    m = np.empty((3, 3))
+    var_m = np.empty((3, 3))
+    biases, var_b = [], []
+    for a, (p, n) in pairs.items():
+        span = p.phi[a] - n.phi[a]
+        m[:, a] = (p.y - n.y) / span
+        var_m[:, a] = (p.var + n.var) / span**2
+        wp, wn = p.phi[a], n.phi[a]
+        biases.append((p.y * wn - n.y * wp) / (wn - wp))
+        var_b.append((p.var * wn**2 + n.var * wp**2) / (wn - wp) ** 2)
+    bias = np.mean(biases, axis=0)
+    sigma_b = np.sqrt(np.sum(var_b, axis=0)) / 3.0
+    return _closed_form_fit(obs, m, bias, np.sqrt(var_m), sigma_b, "rate")
+
+
+def fit_angle_pairs(obs: list[Observation], plan: Plan) -> Fit:
+    """Eq 31: ``M_ij = (Theta_i(+) - Theta_i(-)) / (theta(+) - theta(-))``.
+
+    The bias cancels when both turns last equally long; otherwise the bias
+    from the static periods (their mean) is removed first. The bias reported is
+    that static mean (or, with no static period, the pairwise value assuming
+    equal durations).
+    """
+    pairs = _pairs(obs, plan, "angle")
+    statics = [o for o in obs if o.segment.kind == "static"]
+    if statics:
+        w = np.array([o.duration for o in statics])
+        bias = np.average([o.y for o in statics], axis=0, weights=w)
+        sigma_b = np.sqrt(np.sum([o.var * wi**2 for o, wi in zip(statics, w)], axis=0)) / w.sum()
+    else:
+        bias, sigma_b = None, None
+    m = np.empty((3, 3))
+    var_m = np.empty((3, 3))
+    pair_bias = []
+    for a, (p, n) in pairs.items():
+        span = p.phi[a] - n.phi[a]
+        yp, yn = p.y, n.y
+        if bias is not None:
+            yp, yn = yp - bias * p.duration, yn - bias * n.duration
+        else:
+            pair_bias.append((p.y + n.y) / (p.duration + n.duration))
+        m[:, a] = (yp - yn) / span
+        var_m[:, a] = (p.var + n.var) / span**2
+    if bias is None:
+        bias = np.mean(pair_bias, axis=0)
+        sigma_b = np.full(3, np.nan)
+    return _closed_form_fit(obs, m, bias, np.sqrt(var_m), sigma_b, "angle")
+
+
+def _closed_form_fit(obs, m, bias, sigma_m, sigma_b, method) -> Fit:
+    phi, y, _ = _design(obs)
+    resid = y - phi @ np.hstack([m, bias[:, None]]).T
+    cov = np.zeros((3, 4, 4))
+    for i in range(3):
+        cov[i] = np.diag(np.append(sigma_m[i], sigma_b[i]) ** 2)
+    return Fit(m, bias, sigma_m, sigma_b, cov, resid, len(obs) - 4, np.full(3, np.nan), condition_number(phi), method)
+
+
+def two_axis(fit: Fit, missing: int, variant: str = "procrustes") -> np.ndarray:
+    """Complete ``M`` from two measured columns, assuming orthogonal gyros (Eq 35-36).
+
+    Parameters
+    ----------
+    fit : Fit
+        A fit whose columns other than ``missing`` are measured.
+    missing : int
+        The axis not turned about (0, 1, 2).
+    variant : {"procrustes", "cross"}
+        ``"cross"``: the source's cross product of the two measured columns
+        (Eq 36, e.g. ``M11 = M22 M33 - M32 M23``). ``"procrustes"``: the nearest
+        rotation to the two measured columns (SVD of ``C E^T``), whose third
+        column is used; unlike the cross product it is not scaled by the
+        gyros' scale errors.
+
+    Returns
+    -------
+    ndarray, shape (3, 3)
+    """
+    m = fit.M.copy()
+    j, k = (missing + 1) % 3, (missing + 2) % 3
+    if variant == "cross":
+        m[:, missing] = np.cross(m[:, j], m[:, k])
+    elif variant == "procrustes":
+        e = np.eye(3)[:, [j, k]]
+        c = m[:, [j, k]]
+        r = nearest_rotation(c @ e.T)
+        m[:, missing] = r[:, missing]
+    else:
+        raise ValueError(f"unknown two-axis variant {variant!r}")
+    return m
+
+
+def two_axis_error_bound(axis_to_axis: float) -> float:
+    """Direction error (rad) of the inferred column for a stated axis-to-axis spec.
+
+    To first order the inferred column's off-axis elements are each in error by
+    the true ``delta_ij`` of the gyro pairs involving the missing axis, so the
+    column's direction is off by up to ``sqrt(2) * spec``.
+    """
+    return float(np.sqrt(2.0) * axis_to_axis)
+
+
+def alignment_sigma(m: np.ndarray, cov: np.ndarray) -> np.ndarray:
+    """1-sigma of ``A = M^-1`` by first-order propagation ``dA = -A dM A``.
+
+    ``cov`` holds each row's covariance (3, 4, 4); rows are independent.
+    """
+    a = np.linalg.inv(m)
+    var = np.zeros((3, 3))
+    for i in range(3):
+        # dA_kl = -sum_j A_ki dM_ij A_jl  ->  gradient over row i: g_j = A_ki A_jl
+        grad = np.einsum("k,jl->klj", a[:, i], a)
+        var += np.einsum("klj,jm,klm->kl", grad, cov[i, :3, :3], grad)
+    return np.sqrt(var)

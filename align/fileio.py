@@ -1,0 +1,285 @@
+"""File formats: the one place that reads and writes files.
+
+Logs are CSV (optionally .gz), .npy or .parquet; plans and mount files are
+TOML; results are versioned JSON; firmware gets a C header. Readers turn every
+problem into an :class:`~align.errors.InputError` naming the file and field;
+writers are atomic (a temporary file renamed into place), so a failed run
+never leaves a half-written output.
+
+Public names
+------------
+read_columns, read_log, read_toml, read_json, write_json, write_text,
+write_csv, c_header
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from .errors import InputError
+from .units import parse_unit
+
+
+def _exists(path: str | Path) -> Path:
+    p = Path(path)
+    if not p.is_file():
+        raise InputError("file not found", str(path))
+    return p
+
+
+def read_columns(path: str | Path, names: list[str] | None = None) -> tuple[list[str], np.ndarray]:
+    """Read named numeric columns of a CSV (.csv, .csv.gz), .parquet or .npy file.
+
+    Parameters
+    ----------
+    path : str or Path
+    names : list of str, optional
+        Columns to read (all when None). For .npy files (no names) the columns
+        are taken in order and named ``col0, col1, ...`` unless ``names``
+        matches the array's width.
+
+    Returns
+    -------
+    names : list of str
+    data : ndarray, shape (n, k), float64
+    """
+    p = _exists(path)
+    suffixes = "".join(p.suffixes[-2:]).lower()
+    if p.suffix.lower() == ".npy":
+        try:
+            arr = np.load(p, mmap_mode="r")
+        except (ValueError, OSError) as exc:
+            raise InputError(f"cannot read .npy ({exc})", str(path)) from None
+        arr = np.asarray(arr, dtype=float)
+        if arr.ndim == 1:
+            arr = arr[:, None]
+        if arr.ndim != 2:
+            raise InputError(f"expected an n x k array, got shape {arr.shape}", str(path))
+        if names is not None and len(names) == arr.shape[1]:
+            return list(names), arr
+        if names is not None:
+            raise InputError(f"has {arr.shape[1]} columns, expected {len(names)} ({', '.join(names)})", str(path))
+        return [f"col{i}" for i in range(arr.shape[1])], arr
+    if p.suffix.lower() == ".parquet":
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        try:
+            schema_names = pq.read_schema(p).names
+        except Exception as exc:  # pyarrow raises several types for a bad file
+            raise InputError(f"cannot read parquet ({exc})", str(path)) from None
+        _require(names, schema_names, path)
+        table = pq.read_table(p, columns=names)
+        table = table.cast(pa.schema([(n, pa.float64()) for n in table.column_names]))
+    elif suffixes.endswith((".csv", ".csv.gz", ".txt", ".txt.gz")) or p.suffix.lower() in (".csv", ".gz"):
+        import pyarrow as pa
+        import pyarrow.csv as pcsv
+
+        try:
+            with pcsv.open_csv(p) as reader:
+                header = reader.schema.names
+        except (pa.ArrowInvalid, OSError) as exc:
+            raise InputError(f"cannot read CSV ({str(exc).splitlines()[0]})", str(path)) from None
+        _require(names, header, path)
+        wanted = names or header
+        opts = pcsv.ConvertOptions(include_columns=wanted, column_types={n: pa.float64() for n in wanted})
+        try:
+            table = pcsv.read_csv(p, convert_options=opts)
+        except pa.ArrowInvalid as exc:
+            msg = str(exc).splitlines()[0]
+            raise InputError(f"a value is not a number ({msg}); clean the file", str(path)) from None
+    else:
+        raise InputError("unknown file type; use .csv, .csv.gz, .npy or .parquet", str(path))
+    cols = names or table.column_names
+    data = np.empty((len(cols), table.num_rows))  # filled row by row, returned transposed
+    for j, name in enumerate(cols):
+        pos = 0
+        for chunk in table.column(name).chunks:
+            data[j, pos : pos + len(chunk)] = _float_chunk(chunk)
+            pos += len(chunk)
+    return list(cols), data.T
+
+
+def _float_chunk(chunk) -> np.ndarray:
+    """A float64 Arrow array as numpy, empty cells as NaN.
+
+    Reads the buffers directly: ``Array.to_numpy`` imports pandas on first use,
+    which alone costs more than reading a million-row CSV.
+    """
+    validity, values = chunk.buffers()[:2]
+    arr = np.frombuffer(values, dtype=np.float64, count=len(chunk) + chunk.offset)[chunk.offset :]
+    if chunk.null_count:
+        bits = np.unpackbits(np.frombuffer(validity, dtype=np.uint8), bitorder="little")
+        arr = np.where(bits[chunk.offset : chunk.offset + len(chunk)].astype(bool), arr, np.nan)
+    return arr
+
+
+def _require(names: list[str] | None, available: list[str], path) -> None:
+    if names is None:
+        return
+    missing = [n for n in names if n not in available]
+    if missing:
+        raise InputError(
+            f"no column {', '.join(repr(m) for m in missing)} (columns: {', '.join(available) or 'none'}); "
+            "name the columns with --columns",
+            str(path),
+        )
+
+
+def read_log(
+    path: str | Path,
+    columns: list[str],
+    units: str,
+    time_column: str | None = "time",
+    rate_hz: float | None = None,
+    expect: str = "angular_rate",
+) -> tuple[np.ndarray, np.ndarray]:
+    """Read a sensor log: time (s) and data columns converted to SI.
+
+    Parameters
+    ----------
+    path : str or Path
+    columns : list of str
+        The data columns, e.g. ``["gyro_x", "gyro_y", "gyro_z"]``.
+    units : str
+        Unit of the data columns, e.g. ``"deg/s"``; checked against ``expect``.
+    time_column : str or None
+        Name of the time column (seconds); None when ``rate_hz`` is given.
+    rate_hz : float, optional
+        Sample rate for logs without a time column.
+
+    Returns
+    -------
+    t : ndarray, shape (n,)
+    data : ndarray, shape (n, len(columns)), SI
+    """
+    factor = parse_unit(units, expect, "--units" if expect != "angular_rate" else "--gyro-units").factor
+    use_time = time_column is not None and rate_hz is None
+    wanted = ([time_column] if use_time else []) + list(columns)
+    p = Path(path)
+    if p.suffix.lower() == ".npy":
+        _, arr = read_columns(p)
+        if arr.shape[1] != len(wanted):
+            raise InputError(
+                f"has {arr.shape[1]} columns; expected {len(wanted)} ({', '.join(wanted)})"
+                + ("" if use_time else "") + ("; give --rate-hz for a file without time" if use_time else ""),
+                str(path),
+            )
+        data = arr
+    else:
+        _, data = read_columns(p, wanted)
+    if use_time:
+        t, values = data[:, 0], data[:, 1:]
+    else:
+        if not rate_hz or rate_hz <= 0:
+            raise InputError("no time column: give --rate-hz", str(path))
+        t, values = np.arange(len(data)) / rate_hz, data
+    return np.ascontiguousarray(t), values * factor
+
+
+def read_toml(path: str | Path) -> dict:
+    """Parse a TOML file; a syntax error names the file and line."""
+    p = _exists(path)
+    try:
+        with open(p, "rb") as fh:
+            return tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"not valid TOML ({exc})", str(path)) from None
+
+
+def read_json(path: str | Path) -> dict:
+    """Parse a JSON object; a syntax error names the file."""
+    p = _exists(path)
+    try:
+        data = json.loads(p.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"not valid JSON ({exc})", str(path)) from None
+    if not isinstance(data, dict):
+        raise InputError("expected a JSON object at the top level", str(path))
+    return data
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def _atomic(path: str | Path, write) -> None:
+    p = Path(path)
+    if p.parent and not p.parent.exists():
+        raise InputError("output folder does not exist", str(path))
+    fd, tmp = tempfile.mkstemp(dir=p.parent or ".", prefix=f".{p.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            write(fh)
+        os.chmod(tmp, 0o666 & ~_umask())
+        os.replace(tmp, p)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def write_text(path: str | Path, text: str) -> None:
+    """Write text atomically."""
+    _atomic(path, lambda fh: fh.write(text.encode()))
+
+
+def write_json(path: str | Path, data: dict) -> None:
+    """Write a JSON object atomically (indented, NaN written as null)."""
+    write_text(path, json.dumps(_clean(data), indent=2) + "\n")
+
+
+def _clean(x):
+    if isinstance(x, dict):
+        return {k: _clean(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_clean(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return _clean(x.tolist())
+    if isinstance(x, (float, np.floating)):
+        return None if not np.isfinite(x) else float(x)
+    if isinstance(x, np.integer):
+        return int(x)
+    return x
+
+
+def write_csv(path: str | Path, names: list[str], data: np.ndarray) -> None:
+    """Write numeric columns as CSV atomically (pyarrow's writer, full float precision)."""
+    import pyarrow as pa
+    import pyarrow.csv as pcsv
+
+    table = pa.table({n: np.ascontiguousarray(data[:, j]) for j, n in enumerate(names)})
+    _atomic(path, lambda fh: pcsv.write_csv(table, fh))
+
+
+def c_header(name: str, matrix: np.ndarray, bias: np.ndarray, bias_unit: str, comment: str) -> str:
+    """A C header with the alignment matrix and bias as literals.
+
+    ``<name>_A[3][3]`` (row-major) and ``<name>_BIAS[3]`` for ``w = A (g - b)``.
+    """
+    guard = f"{name.upper()}_H"
+    rows = ",\n".join("    {" + ", ".join(f"{v:.10e}f" for v in row) + "}" for row in matrix)
+    lines = [
+        f"/* {line} */" for line in comment.splitlines()
+    ] + [
+        f"#ifndef {guard}",
+        f"#define {guard}",
+        "",
+        f"/* alignment matrix A = M^-1, dimensionless: w = A (g - b) */",
+        f"static const float {name}_A[3][3] = {{\n{rows}\n}};",
+        "",
+        f"/* gyro bias b in {bias_unit} */",
+        f"static const float {name}_BIAS[3] = {{" + ", ".join(f"{v:.10e}f" for v in bias) + "};",
+        "",
+        f"#endif /* {guard} */",
+        "",
+    ]
+    return "\n".join(lines)

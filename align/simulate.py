@@ -1,0 +1,143 @@
+"""Rate-table session simulator: known truth for rehearsals, tests and examples.
+
+The table runs a :class:`~align.plan.Plan`: a static gap, then for each step a
+ramp up at a constant angular acceleration, the dwell (rate steps) or cruise
+(angle steps), a ramp down, and another static gap. The gyros read
+``g = M (w_table + w_earth) + b(t) + noise`` with ``b(t)`` a turn-on bias plus a
+random walk, white noise from a noise density, an optional table rate/angle
+error and saturation at a stated range.
+
+Public names
+------------
+SessionSpec, simulate_session
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .earth import earth_rate_in_frame
+from .model import SensorModel
+from .plan import Plan
+from .units import DEG, DEG_S
+
+
+@dataclass(frozen=True)
+class SessionSpec:
+    """How the simulated table and gyros behave (SI units).
+
+    Attributes
+    ----------
+    fs : float
+        Sample rate, Hz.
+    dwell_s : float
+        Constant-rate part of each rate step, s.
+    static_s : float
+        Static gap before the first step, between steps and after the last, s.
+    accel : float
+        Table angular acceleration on the ramps, rad/s^2.
+    turn_rate : float
+        Cruise rate of angle steps, rad/s.
+    noise_density : float
+        White rate noise, rad/s/sqrt(Hz) (numerically the ARW in rad/sqrt(s)).
+    bias_walk : float
+        Rate random walk of the bias, rad/s/sqrt(s).
+    table_rate_error : float
+        Relative error of the table rate (the table turns at ``rate (1 + e)``).
+    table_angle_error : float
+        Relative error of the table angle for angle steps.
+    latitude : float or None
+        Adds Earth rate (rad) when set.
+    gyro_range : float or None
+        Saturation, rad/s.
+    """
+
+    fs: float = 200.0
+    dwell_s: float = 10.0
+    static_s: float = 3.0
+    accel: float = 200.0 * DEG
+    turn_rate: float = 30.0 * DEG_S
+    noise_density: float = 0.005 * DEG_S
+    bias_walk: float = 0.0
+    table_rate_error: float = 0.0
+    table_angle_error: float = 0.0
+    latitude: float | None = None
+    gyro_range: float | None = None
+
+
+def _profile(step, spec: SessionSpec) -> np.ndarray:
+    """Table rate magnitude profile (signed, rad/s) for one step, without gaps."""
+    dt = 1.0 / spec.fs
+    if step.rate is not None:
+        peak = step.rate * (1.0 + spec.table_rate_error)
+        t_ramp = abs(peak) / spec.accel
+        cruise = spec.dwell_s
+    else:
+        total = abs(step.angle) * (1.0 + spec.table_angle_error)
+        peak_abs = min(spec.turn_rate, np.sqrt(total * spec.accel))
+        t_ramp = peak_abs / spec.accel
+        cruise = (total - peak_abs * t_ramp) / peak_abs
+        peak = np.sign(step.angle) * peak_abs
+    n_ramp = max(int(np.ceil(t_ramp / dt)), 1)
+    ramp = np.linspace(0.0, 1.0, n_ramp, endpoint=False) + 0.5 / n_ramp
+    n_cruise = int(np.floor(cruise / dt))
+    prof = np.concatenate([ramp, np.ones(n_cruise), ramp[::-1]]) * peak
+    if step.angle is not None:  # put the last fraction of a sample back so the angle is exact
+        want = step.angle * (1.0 + spec.table_angle_error)
+        prof *= want / (prof.sum() * dt)
+    return prof
+
+
+def simulate_session(plan: Plan, model: SensorModel, spec: SessionSpec = SessionSpec(), seed: int | np.random.Generator = 0):
+    """Simulate the gyro log of a rate-table session.
+
+    Parameters
+    ----------
+    plan : Plan
+        The steps to run, in order.
+    model : SensorModel
+        True ``M`` and turn-on bias (rad/s).
+    spec : SessionSpec
+    seed : int or numpy.random.Generator
+
+    Returns
+    -------
+    t : ndarray, shape (n,)
+        Time, s, from 0 at ``spec.fs``.
+    g : ndarray, shape (n, 3)
+        Gyro readings, rad/s.
+    w : ndarray, shape (n, 3)
+        True angular rate of the system frame, rad/s (table plus Earth).
+    """
+    rng = np.random.default_rng(seed)
+    gap = np.zeros(int(round(spec.static_s * spec.fs)))
+    pieces, axes = [], []
+    for step in plan.steps:
+        prof = _profile(step, spec)
+        for part in (gap, prof):
+            pieces.append(part)
+            axes.append(np.repeat(step.unit_axis[None, :], len(part), axis=0))
+    pieces.append(gap)
+    axes.append(np.repeat(plan.steps[-1].unit_axis[None, :], len(gap), axis=0))
+    rate = np.concatenate(pieces)
+    up = np.concatenate(axes)
+    w = rate[:, None] * up
+    n = len(rate)
+    dt = 1.0 / spec.fs
+    if spec.latitude is not None:
+        heading = np.cumsum(rate) * dt
+        start = 0
+        for piece_axes in axes:  # Earth rate in the frame mounted for each step
+            stop = start + len(piece_axes)
+            if stop > start:
+                w[start:stop] += earth_rate_in_frame(spec.latitude, piece_axes[0], heading[start:stop])
+            start = stop
+    bias = np.broadcast_to(model.bias, (n, 3))
+    if spec.bias_walk > 0:
+        bias = bias + np.cumsum(rng.standard_normal((n, 3)) * spec.bias_walk * np.sqrt(dt), axis=0)
+    g = w @ model.M.T + bias + rng.standard_normal((n, 3)) * spec.noise_density * np.sqrt(spec.fs)
+    if spec.gyro_range is not None:
+        g = np.clip(g, -spec.gyro_range, spec.gyro_range)
+    return np.arange(n) * dt, g, w

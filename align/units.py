@@ -1,0 +1,251 @@
+"""Units: the one place where unit strings become SI numbers.
+
+Quantities enter the program as strings with an explicit unit ("100 deg/s",
+"0.2 mm", "0.3 deg/sqrt(h)", "15 deg/h") and leave it the same way; inside,
+everything is SI with angles in radians. Angle is kept as a dimension of its own
+so that a length given where an angle is expected is caught.
+
+Public names
+------------
+parse_unit, parse_quantity, to_unit, format_quantity, unit_mixup_hint, Unit, DIMENSIONS,
+DEG, DEG_S, DEG_H, ARCSEC, MM, HOUR, STANDARD_GRAVITY
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from fractions import Fraction
+from functools import lru_cache
+
+from .errors import UnitError
+
+#: one degree in radians
+DEG = math.pi / 180.0
+#: one degree per second in rad/s
+DEG_S = DEG
+#: one degree per hour in rad/s
+DEG_H = DEG / 3600.0
+#: one arc second in radians
+ARCSEC = DEG / 3600.0
+#: one millimetre in metres
+MM = 1e-3
+#: one hour in seconds
+HOUR = 3600.0
+#: standard gravity in m/s^2 (the unit "g")
+STANDARD_GRAVITY = 9.80665
+
+_BASES = ("m", "s", "rad", "T", "count")
+
+
+@dataclass(frozen=True)
+class Unit:
+    """A unit: a factor to SI and a dimension (exponents of m, s, rad, T, count)."""
+
+    factor: float
+    dim: tuple[Fraction, ...]
+
+    def __mul__(self, other: "Unit") -> "Unit":
+        return Unit(self.factor * other.factor, tuple(a + b for a, b in zip(self.dim, other.dim)))
+
+    def __truediv__(self, other: "Unit") -> "Unit":
+        return Unit(self.factor / other.factor, tuple(a - b for a, b in zip(self.dim, other.dim)))
+
+    def __pow__(self, p: Fraction) -> "Unit":
+        return Unit(self.factor ** float(p), tuple(a * p for a in self.dim))
+
+
+def _u(factor: float, **exps: int) -> Unit:
+    return Unit(factor, tuple(Fraction(exps.get(b, 0)) for b in _BASES))
+
+
+_ONE = _u(1.0)
+_PREFIXES = {"n": 1e-9, "u": 1e-6, "µ": 1e-6, "m": 1e-3, "k": 1e3}
+_ATOMS: dict[str, Unit] = {
+    "m": _u(1.0, m=1), "in": _u(0.0254, m=1), "inch": _u(0.0254, m=1),
+    "s": _u(1.0, s=1), "sec": _u(1.0, s=1), "min": _u(60.0, s=1),
+    "h": _u(3600.0, s=1), "hr": _u(3600.0, s=1), "hour": _u(3600.0, s=1),
+    "Hz": _u(1.0, s=-1),
+    "rad": _u(1.0, rad=1), "deg": _u(DEG, rad=1), "°": _u(DEG, rad=1),
+    "arcmin": _u(DEG / 60.0, rad=1), "arcsec": _u(ARCSEC, rad=1),
+    "rev": _u(2 * math.pi, rad=1),
+    "dps": _u(DEG, rad=1, s=-1), "rpm": _u(2 * math.pi / 60.0, rad=1, s=-1),
+    "g": _u(STANDARD_GRAVITY, m=1, s=-2),
+    "T": _u(1.0, T=1), "gauss": _u(1e-4, T=1), "G": _u(1e-4, T=1),
+    "count": _u(1.0, count=1), "counts": _u(1.0, count=1), "LSB": _u(1.0, count=1),
+    "%": _u(1e-2), "ppm": _u(1e-6), "1": _ONE,
+}
+_PREFIXABLE = {"m", "s", "rad", "deg", "dps", "g", "T", "G", "gauss", "Hz"}
+
+#: named dimensions a caller can ask for
+DIMENSIONS: dict[str, tuple[Unit, str]] = {
+    "angle": (_u(1, rad=1), "an angle, e.g. '1 deg'"),
+    "angular_rate": (_u(1, rad=1, s=-1), "an angular rate, e.g. '100 deg/s'"),
+    "length": (_u(1, m=1), "a length, e.g. '0.2 mm'"),
+    "time": (_u(1, s=1), "a time, e.g. '30 s'"),
+    "frequency": (_u(1, s=-1), "a frequency, e.g. '100 Hz'"),
+    "acceleration": (_u(1, m=1, s=-2), "an acceleration, e.g. '9.81 m/s^2'"),
+    "magnetic_field": (_u(1, T=1), "a magnetic field, e.g. '50 uT'"),
+    "angle_random_walk": (_u(1, rad=1, s=Fraction(-1, 2)), "an angle random walk, e.g. '0.3 deg/sqrt(h)'"),
+    "rate_random_walk": (_u(1, rad=1, s=Fraction(-3, 2)), "a rate random walk, e.g. '3 deg/h/sqrt(h)'"),
+    "velocity_random_walk": (_u(1, m=1, s=Fraction(-3, 2)), "a velocity random walk, e.g. '0.05 m/s/sqrt(h)'"),
+    "dimensionless": (_ONE, "a plain number or ratio, e.g. '0.1 %'"),
+    "counts": (_u(1, count=1), "raw counts"),
+}
+
+_TOKEN = re.compile(r"\s*(sqrt\(|\*\*|[*/^()]|[-+]?\d+(?:\.\d+)?|[A-Za-zµ°%][A-Za-z0-9µ°_]*|%)")
+
+
+def _atom(name: str) -> Unit:
+    if name in _ATOMS:
+        return _ATOMS[name]
+    if len(name) > 1 and name[0] in _PREFIXES and name[1:] in _PREFIXABLE:
+        base = _ATOMS[name[1:]]
+        return Unit(base.factor * _PREFIXES[name[0]], base.dim)
+    raise ValueError(f"unknown unit '{name}'")
+
+
+class _Parser:
+    """Recursive-descent parser: expr := term (('*'|'/') term)*; term := atom ('^' num)?"""
+
+    def __init__(self, text: str) -> None:
+        pos, toks = 0, []
+        text = text.strip()
+        while pos < len(text):
+            m = _TOKEN.match(text, pos)
+            if not m or m.end() == pos:
+                raise ValueError(f"cannot read '{text[pos:]}'")
+            toks.append(m.group(1))
+            pos = m.end()
+        self.toks, self.i = toks, 0
+
+    def peek(self) -> str | None:
+        return self.toks[self.i] if self.i < len(self.toks) else None
+
+    def take(self) -> str:
+        tok = self.peek()
+        if tok is None:
+            raise ValueError("unit ends too early")
+        self.i += 1
+        return tok
+
+    def expr(self) -> Unit:
+        unit = self.term()
+        while self.peek() in ("*", "/"):
+            op = self.take()
+            rhs = self.term()
+            unit = unit * rhs if op == "*" else unit / rhs
+        return unit
+
+    def term(self) -> Unit:
+        tok = self.take()
+        if tok == "sqrt(":
+            unit = self.expr() ** Fraction(1, 2)
+            if self.take() != ")":
+                raise ValueError("missing ')'")
+        elif tok == "(":
+            unit = self.expr()
+            if self.take() != ")":
+                raise ValueError("missing ')'")
+        else:
+            unit = _atom(tok)
+        if self.peek() in ("^", "**"):
+            self.take()
+            unit = unit ** Fraction(self.take())
+        return unit
+
+
+@lru_cache(maxsize=256)
+def parse_unit(text: str, expect: str | None = None, where: str | None = None) -> Unit:
+    """Parse a unit string such as ``"deg/s"`` or ``"deg/h/sqrt(h)"``.
+
+    Parameters
+    ----------
+    text : str
+        The unit. ``"dps"``, ``"mdps"``, ``"rad/s"``, ``"deg/sqrt(h)"``, ``"m/s^2"``,
+        ``"uT"``, ``"%"`` and the like.
+    expect : str, optional
+        A key of :data:`DIMENSIONS`; the unit must have that dimension.
+    where : str, optional
+        Name of the file field or option, for the error message.
+
+    Returns
+    -------
+    Unit
+        Its factor to SI (angles in radians) and its dimension.
+    """
+    try:
+        parser = _Parser(text)
+        unit = parser.expr() if parser.toks else _ONE
+        if parser.peek() is not None:
+            raise ValueError(f"unexpected '{parser.peek()}'")
+    except (ValueError, ZeroDivisionError, IndexError) as exc:
+        raise UnitError(f"cannot read unit '{text}' ({exc})", where) from None
+    if expect is not None:
+        want, example = DIMENSIONS[expect]
+        if unit.dim != want.dim:
+            raise UnitError(f"'{text}' is not {example}", where)
+    return unit
+
+
+_NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*)$")
+
+
+def parse_quantity(text: str | float | int, expect: str, where: str | None = None) -> float:
+    """Parse ``"<number> <unit>"`` into an SI float.
+
+    Parameters
+    ----------
+    text : str
+        For example ``"100 deg/s"``, ``"-360 deg"``, ``"0.3 deg/sqrt(h)"``.
+        A bare number is accepted only for ``expect="dimensionless"``.
+    expect : str
+        A key of :data:`DIMENSIONS`.
+    where : str, optional
+        Name of the field, for the error message.
+
+    Returns
+    -------
+    float
+        The value in SI units (radians for angles).
+    """
+    if isinstance(text, bool) or not isinstance(text, (str, int, float)):
+        raise UnitError(f"expected a quantity string such as {DIMENSIONS[expect][1]!s}, got {text!r}", where)
+    if not isinstance(text, str):
+        if expect == "dimensionless":
+            return float(text)
+        raise UnitError(f"{text!r} has no unit; write {DIMENSIONS[expect][1]}", where)
+    m = _NUMBER.match(text)
+    if not m:
+        raise UnitError(f"'{text}' does not start with a number; write {DIMENSIONS[expect][1]}", where)
+    value, unit_text = float(m.group(1)), m.group(2).strip()
+    if not unit_text and expect != "dimensionless":
+        raise UnitError(f"'{text}' has no unit; write {DIMENSIONS[expect][1]}", where)
+    if not math.isfinite(value):
+        raise UnitError(f"'{text}' is not a finite number", where)
+    return value * parse_unit(unit_text, expect, where).factor
+
+
+def to_unit(value_si, unit: str):
+    """Convert an SI value (scalar or array) to ``unit`` (inverse of parsing)."""
+    return value_si / parse_unit(unit).factor
+
+
+def format_quantity(value_si: float, unit: str, digits: int = 6) -> str:
+    """Format an SI value as ``"<number> <unit>"``, the form the parser reads back."""
+    return f"{to_unit(value_si, unit):.{digits}g} {unit}"
+
+
+_MIXUPS = ((180 / math.pi, "the log looks like deg/s read as rad/s: set --gyro-units deg/s"),
+           (math.pi / 180, "the log looks like rad/s read as deg/s: set --gyro-units rad/s"),
+           (1e3, "mdps read as deg/s? set --gyro-units mdps"),
+           (1e-3, "deg/s read as mdps? check --gyro-units"))
+
+
+def unit_mixup_hint(ratio: float) -> str | None:
+    """A message when measured/planned rates differ by a unit factor (57.3, 1/57.3, 1000, 1/1000)."""
+    for factor, hint in _MIXUPS:
+        if abs(ratio / factor - 1) < 0.1:
+            return f"measured rates are {ratio:.4g}x the plan's: {hint}"
+    return None

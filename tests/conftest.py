@@ -1,0 +1,62 @@
+"""Shared test helpers: simulated sessions of known truth and an in-process CLI runner."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from align.model import SensorModel
+from align.units import DEG
+
+ROOT = Path(__file__).resolve().parents[1]
+SHARED = ROOT.parent / "shared"
+
+
+def truth_model(seed: int = 0, rot_deg: float = 0.6, scale_sd: float = 3e-3, delta_deg: float = 0.05,
+                bias_deg_s: float = 0.5) -> SensorModel:
+    """A random but realistic true M and bias (rad/s)."""
+    rng = np.random.default_rng(1000 + seed)
+    return SensorModel.from_rotation(
+        Rotation.from_rotvec(rng.normal(0, rot_deg * DEG, 3)),
+        scale=1 + rng.normal(0, scale_sd, 3),
+        delta=rng.normal(0, delta_deg * DEG, 3),
+        bias=rng.normal(0, bias_deg_s * DEG, 3),
+    )
+
+
+def write_session(folder: Path, t: np.ndarray, g: np.ndarray, plan, units: str = "deg/s") -> tuple[Path, Path]:
+    """Write a simulated session as the CLI reads it."""
+    from align import fileio
+    from align.units import to_unit
+
+    log, plan_path = folder / "session.csv", folder / "plan.toml"
+    fileio.write_csv(log, ["time", "gyro_x", "gyro_y", "gyro_z"], np.column_stack([t, to_unit(g, units)]))
+    fileio.write_text(plan_path, plan.to_toml())
+    return log, plan_path
+
+
+class CliResult:
+    def __init__(self, code: int, out: str, err: str) -> None:
+        self.code, self.out, self.err = code, out, err
+
+
+@pytest.fixture
+def run_cli(capsys, monkeypatch):
+    """Run ``imu-align ARGS`` in-process; returns exit code, stdout, stderr."""
+    from align.cli import main
+
+    def run(*args) -> CliResult:
+        monkeypatch.setattr(sys, "argv", ["imu-align", *map(str, args)])
+        code = 0
+        try:
+            main()
+        except SystemExit as exc:
+            code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+        cap = capsys.readouterr()
+        return CliResult(code, cap.out, cap.err)
+
+    return run
