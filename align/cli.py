@@ -195,6 +195,78 @@ def simulate(
     typer.echo(f"wrote {out_dir}/session.csv ({len(t)} rows, {t[-1]:.1f} s), plan.toml and truth.json")
 
 
+@app.command()
+def budget(
+    mount: Path = typer.Argument(..., help="Mount description TOML ([imu], [package], [ledges] or [baseplate], [screws])."),
+    monte_carlo: int = typer.Option(0, "--monte-carlo", help="Monte Carlo draws (0: none)."),
+    seed: int = typer.Option(0, help="Random seed of the Monte Carlo."),
+    json_out: Optional[Path] = typer.Option(None, "--json", help="Write the versioned JSON result here."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="PNG histogram of the Monte Carlo."),
+    picture: Optional[Path] = typer.Option(None, "--picture", help="PNG of the assembly, tilt exaggerated."),
+    glb: Optional[Path] = typer.Option(None, "--glb", help="GLB of the assembly, tilt exaggerated."),
+    exaggerate: float = typer.Option(30.0, help="Angle exaggeration of --picture and --glb."),
+) -> None:
+    """Mounting-misalignment budget: source formulas, worst case and Monte Carlo."""
+    from . import fileio
+    from .errors import InputError
+    from .summary import budget_summary
+    from mechanics.budget import budget as make_budget
+    from mechanics.budget import monte_carlo as run_mc
+    from mechanics.mount import mount_from_dict
+
+    if monte_carlo < 0:
+        raise InputError("must be 0 or more", "--monte-carlo")
+    if plot is not None and monte_carlo == 0:
+        raise InputError("the histogram needs --monte-carlo N", "--plot")
+    m = mount_from_dict(fileio.read_toml(mount), str(mount), mount.parent)
+    result = make_budget(m)
+    if monte_carlo:
+        with _progress(monte_carlo, "Monte Carlo") as tick:
+            mc = run_mc(m, monte_carlo, seed, progress=tick)
+        result = type(result)(**{**result.__dict__, "monte_carlo": mc})
+    outputs = []
+    if plot is not None:
+        from mechanics.render import histogram_png
+
+        outputs.append((plot, histogram_png(result)))
+    if picture is not None:
+        from mechanics.render import assembly_png
+
+        outputs.append((picture, assembly_png(m, exaggerate)))
+    if glb is not None:
+        from mechanics.render import assembly_glb
+
+        outputs.append((glb, assembly_glb(m, exaggerate)))
+    typer.echo(budget_summary(result))
+    if json_out is not None:
+        fileio.write_json(json_out, result.to_dict())
+    for path, data in outputs:
+        fileio.write_bytes(path, data)
+
+
+class _progress:
+    """A progress bar on a terminal's stderr; silent when stderr is not a terminal."""
+
+    def __init__(self, total: int, label: str) -> None:
+        self.total, self.label = total, label
+        self.live = sys.stderr.isatty()
+
+    def __enter__(self):
+        def tick(done: int) -> None:
+            if self.live:
+                width = 30
+                filled = int(width * done / self.total)
+                sys.stderr.write(f"\r{self.label} [{'#' * filled}{'.' * (width - filled)}] {done:,}/{self.total:,}")
+                sys.stderr.flush()
+
+        return tick
+
+    def __exit__(self, *exc) -> None:
+        if self.live:
+            sys.stderr.write("\r" + " " * 70 + "\r")
+            sys.stderr.flush()
+
+
 def main() -> None:
     """Entry point: run the app, turning user-facing errors into one line and an exit code."""
     from .errors import AlignError

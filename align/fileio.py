@@ -8,7 +8,7 @@ never leaves a half-written output.
 
 Public names
 ------------
-read_columns, read_log, read_toml, read_json, write_json, write_text,
+read_columns, read_log, read_toml, read_json, write_json, write_text, write_bytes,
 write_csv, c_header
 """
 
@@ -225,6 +225,11 @@ def _atomic(path: str | Path, write) -> None:
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
+
+
+def write_bytes(path: str | Path, data: bytes) -> None:
+    """Write bytes atomically (pictures, GLB)."""
+    _atomic(path, lambda fh: fh.write(data))
 
 
 def write_text(path: str | Path, text: str) -> None:

@@ -56,3 +56,37 @@ def alignment_summary(r: AlignmentResult) -> str:
     out += ["", "checks:"] + [f"  [{c.status}] {c.name}: {c.detail}" for c in r.checks]
     out += ["", "notes:"] + [f"  - {n}" for n in r.notes]
     return "\n".join(out)
+
+
+def budget_summary(b) -> str:
+    """The table ``imu-align budget`` prints: source, per-axis, worst case and Monte Carlo."""
+    d = b.to_dict()
+    m = d["mount"]
+    lines = [
+        "Mounting-misalignment budget (angle between each gyro axis and its system axis)",
+        "",
+        f"  part {m['part'] or '-'}, axis-to-package {', '.join(f'{v:.3g}' for v in m['axis_to_package_deg'])} deg, "
+        f"package {m['package_mm'][0]:g} x {m['package_mm'][1]:g} mm, ledges {m['ledge_size_mm']:g} mm, "
+        f"height band {m['height_tolerance_mm']:g} mm, screws {m['screw_diameter_mm']:g} mm in {m['hole_diameter_mm']:g} mm holes, "
+        f"R_S {m['screw_radius_mm']:.4f} mm",
+        "",
+        "  source (Eq 1-4)                        deg",
+        f"    tilt about x   (Eq 2)           {d['tilt_x_deg']:10.5f}",
+        f"    tilt about y   (Eq 3)           {d['tilt_y_deg']:10.5f}",
+        f"    skew about z   (Eq 4)           {d['skew_z_deg']:10.5f}",
+        f"    mounting = largest              {d['mounting_deg']:10.5f}",
+        f"    total, RSS with datasheet (Eq 1){d['total_deg']:10.5f}",
+        f"    plain sum                       {d['sum_deg']:10.5f}",
+        "",
+        "  per gyro axis                x          y          z",
+        "    RSS                  " + "".join(f"{d['per_axis_deg'][a]:11.5f}" for a in "xyz"),
+        "    worst case (3-D)     " + "".join(f"{d['worst_case_per_axis_deg'][a]:11.5f}" for a in "xyz"),
+    ]
+    mc = d.get("monte_carlo")
+    if mc:
+        for p, vals in mc["percentiles_deg"].items():
+            lines.append(f"    Monte Carlo p{p:<6}  " + "".join(f"{vals[a]:11.5f}" for a in "xyz") + f"   any axis {vals['any']:.5f}")
+        lines.append("    Monte Carlo max      " + "".join(f"{mc['max_deg'][a]:11.5f}" for a in "xyz")
+                     + f"   ({mc['draws']:,} draws, seed {mc['seed']})")
+    lines += ["", f"  worst case over all axes {d['worst_case_deg']:.5f} deg; source total {d['total_deg']:.5f} deg"]
+    return "\n".join(lines)

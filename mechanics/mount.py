@@ -1,0 +1,191 @@
+"""The mount description: IMU, package, ledges (or a baseplate STL), screws and extra terms.
+
+A mount is read from TOML with unit strings (see README) into a frozen
+:class:`Mount` in SI units. Geometry is in the package frame: origin at the
+package centre, x along ``size_x``, y along ``size_y``, z up.
+
+Public names
+------------
+Mount, mount_from_dict
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from align.errors import InputError
+from align.parts import get_part
+from align.units import parse_quantity
+
+DISTRIBUTIONS = ("uniform", "normal")
+
+
+@dataclass(frozen=True)
+class Mount:
+    """A mount in SI units (m, rad).
+
+    Attributes
+    ----------
+    axis_to_package : ndarray, shape (3,)
+        Datasheet axis-to-package misalignment bound of each gyro, rad.
+    package : ndarray, shape (3,)
+        Package size x, y, z, m.
+    pads : ndarray, shape (P, V, 2)
+        Outline vertices of each ledge top (package frame), m.
+    pad_heights : ndarray, shape (P,)
+        Nominal height of each ledge top, m.
+    ledge_size : float
+        ``W1`` of Eq 2-3 (square ledges), m.
+    height_tolerance : float
+        Total band of ledge heights, m.
+    screw_diameter, hole_diameter, spacing_x, spacing_y : float
+        m.
+    position_tolerance : float
+        Diameter of each screw's positional tolerance zone, m.
+    extras : dict
+        Further independent misalignment terms (name -> rad), e.g. PCB solder tilt.
+    distributions : dict
+        ``{"imu": ..., "ledges": ..., "extras": ...}``, each "uniform" or "normal"
+        (normal: the band or bound is +/- 3 sigma).
+    """
+
+    axis_to_package: np.ndarray
+    package: np.ndarray
+    pads: np.ndarray
+    pad_heights: np.ndarray
+    ledge_size: float
+    height_tolerance: float
+    screw_diameter: float
+    hole_diameter: float
+    spacing_x: float
+    spacing_y: float
+    position_tolerance: float = 0.0
+    extras: dict = field(default_factory=dict)
+    distributions: dict = field(default_factory=lambda: {"imu": "uniform", "ledges": "uniform", "extras": "uniform"})
+    part: str | None = None
+    baseplate: str | None = None
+
+    @property
+    def screws(self) -> np.ndarray:
+        """Nominal screw centres, shape (4, 2), m."""
+        sx, sy = self.spacing_x / 2, self.spacing_y / 2
+        return np.array([[sx, sy], [-sx, sy], [-sx, -sy], [sx, -sy]])
+
+    @property
+    def clearance(self) -> float:
+        """Radial clearance of a screw in its hole, m."""
+        return (self.hole_diameter - self.screw_diameter) / 2.0
+
+
+def _table(data: dict, name: str, where: str, required: bool = True) -> dict:
+    t = data.get(name)
+    if t is None:
+        if required:
+            raise InputError(f"missing table [{name}]", where)
+        return {}
+    if not isinstance(t, dict):
+        raise InputError(f"[{name}] must be a table", where)
+    return t
+
+
+def _length(t: dict, key: str, section: str, where: str, default: str | None = None, positive: bool = True) -> float:
+    if key not in t:
+        if default is None:
+            raise InputError(f"missing field (e.g. {key} = \"2 mm\")", f"{where}: {section}.{key}")
+        value = parse_quantity(default, "length")
+    else:
+        value = parse_quantity(t[key], "length", f"{where}: {section}.{key}")
+    if value < 0 or (positive and value == 0):
+        raise InputError(f"must be {'positive' if positive else 'zero or more'}, got {t.get(key)!r}", f"{where}: {section}.{key}")
+    return value
+
+
+def _distribution(t: dict, section: str, where: str) -> str:
+    d = t.get("distribution", "uniform")
+    if d not in DISTRIBUTIONS:
+        raise InputError(f"distribution '{d}' is not one of {', '.join(DISTRIBUTIONS)}", f"{where}: {section}.distribution")
+    return d
+
+
+def _axis_to_package(imu: dict, where: str) -> tuple[np.ndarray, str | None]:
+    part = imu.get("part")
+    preset = get_part(part, f"{where}: imu.part") if part is not None else None
+    raw = imu.get("axis_to_package")
+    if raw is None:
+        if preset is None or preset.axis_to_package is None:
+            raise InputError("missing field (e.g. axis_to_package = \"1 deg\", or a known part)", f"{where}: imu.axis_to_package")
+        value = np.full(3, preset.si("axis_to_package", "angle"))
+    elif isinstance(raw, dict):
+        missing = [a for a in "xyz" if a not in raw]
+        if missing:
+            raise InputError(f"per-axis table needs x, y and z (missing {', '.join(missing)})", f"{where}: imu.axis_to_package")
+        value = np.array([parse_quantity(raw[a], "angle", f"{where}: imu.axis_to_package.{a}") for a in "xyz"])
+    else:
+        value = np.full(3, parse_quantity(raw, "angle", f"{where}: imu.axis_to_package"))
+    if np.any(value < 0):
+        raise InputError("must not be negative", f"{where}: imu.axis_to_package")
+    return value, (preset.name if preset else None)
+
+
+def mount_from_dict(data: dict, where: str = "mount", base_dir: Path | None = None) -> Mount:
+    """Build a :class:`Mount` from parsed TOML; every problem names the field."""
+    imu = _table(data, "imu", where)
+    axis_to_package, part = _axis_to_package(imu, where)
+    package = _table(data, "package", where)
+    size_x = _length(package, "size_x", "package", where)
+    size_y = _length(package, "size_y", "package", where)
+    size_z = _length(package, "size_z", "package", where, default="10 mm")
+    screws = _table(data, "screws", where)
+    screw_d = _length(screws, "diameter", "screws", where)
+    hole_d = _length(screws, "hole_diameter", "screws", where)
+    if hole_d <= screw_d:
+        raise InputError(f"hole ({hole_d * 1e3:g} mm) must be larger than the screw ({screw_d * 1e3:g} mm)",
+                         f"{where}: screws.hole_diameter")
+    spacing_x = _length(screws, "spacing_x", "screws", where)
+    spacing_y = _length(screws, "spacing_y", "screws", where)
+    pos_tol = _length(screws, "position_tolerance", "screws", where, default="0 mm", positive=False)
+    if spacing_x > size_x or spacing_y > size_y:
+        raise InputError("the screw pattern is larger than the package", f"{where}: screws.spacing_x")
+
+    ledges = _table(data, "ledges", where, required=False)
+    plate = _table(data, "baseplate", where, required=False)
+    if not ledges and not plate:
+        raise InputError("give [ledges] (size, height_tolerance) or [baseplate] stl = \"FILE.stl\"", where)
+    tol = _length(ledges, "height_tolerance", "ledges", where, default="0 mm", positive=False)
+    baseplate = None
+    if plate:
+        from .rest import ledges_from_stl
+
+        if "stl" not in plate:
+            raise InputError("missing field stl = \"FILE.stl\"", f"{where}: baseplate.stl")
+        stl = Path(plate["stl"])
+        if base_dir is not None and not stl.is_absolute():
+            stl = base_dir / stl
+        band = _length(plate, "ledge_band", "baseplate", where, default="1 mm")
+        pads, heights = ledges_from_stl(stl, band, f"{where}: baseplate.stl")
+        size = float(np.median([np.ptp(p[:, 0]) for p in pads]))
+        baseplate = str(stl)
+    else:
+        size = _length(ledges, "size", "ledges", where)
+        if 2 * size >= min(size_x, size_y):
+            raise InputError("ledges overlap: size must be under half the package size", f"{where}: ledges.size")
+        cx, cy, h = size_x / 2 - size / 2, size_y / 2 - size / 2, size / 2
+        square = np.array([[-h, -h], [h, -h], [h, h], [-h, h]])
+        centres = np.array([[cx, cy], [-cx, cy], [-cx, -cy], [cx, -cy]])
+        pads = centres[:, None, :] + square[None, :, :]
+        heights = np.zeros(4)
+    extras_t = _table(data, "extra", where, required=False)
+    extras = {}
+    for name, value in extras_t.items():
+        if name == "distribution":
+            continue
+        extras[name] = parse_quantity(value, "angle", f"{where}: extra.{name}")
+        if extras[name] < 0:
+            raise InputError("must not be negative", f"{where}: extra.{name}")
+    dists = {"imu": _distribution(imu, "imu", where), "ledges": _distribution(ledges, "ledges", where),
+             "extras": _distribution(extras_t, "extra", where)}
+    return Mount(axis_to_package, np.array([size_x, size_y, size_z]), pads, heights, size, tol, screw_d, hole_d,
+                 spacing_x, spacing_y, pos_tol, extras, dists, part, baseplate)
