@@ -244,6 +244,62 @@ def budget(
         fileio.write_bytes(path, data)
 
 
+@app.command()
+def allowable(
+    manoeuvre: Path = typer.Argument(..., help="Manoeuvre TOML: [[rotation]] axis/angle (or [series]) and [limits]."),
+    json_out: Optional[Path] = typer.Option(None, "--json", help="Write the versioned JSON result here."),
+    symbolic: Optional[str] = typer.Option(None, help="Also print the sympy response and sensitivity: pretty | latex."),
+) -> None:
+    """Allowable misalignment per element for a manoeuvre, the binding element and the cone."""
+    from . import fileio
+    from .sensitivity import allowable as compute, manoeuvre_from_dict, symbolic_text
+    from .summary import allowable_summary
+
+    man = manoeuvre_from_dict(fileio.read_toml(manoeuvre), str(manoeuvre), manoeuvre.parent)
+    if symbolic is not None:
+        typer.echo(symbolic_text(symbolic) + "\n")
+    result = compute(man)
+    typer.echo(allowable_summary(result))
+    if json_out is not None:
+        fileio.write_json(json_out, result.to_dict())
+
+
+@app.command()
+def check(
+    mount: Path = typer.Argument(..., help="Mount TOML (see 'budget')."),
+    manoeuvre: Path = typer.Argument(..., help="Manoeuvre TOML (see 'allowable')."),
+    basis: str = typer.Option("rss", help="Budget figure to compare: rss (the source's method) or worst."),
+    json_out: Optional[Path] = typer.Option(None, "--json", help="Write the element table as JSON."),
+) -> None:
+    """The mounting budget against the allowance; exit status 4 when an element fails."""
+    from . import CONVENTION, fileio
+    from .errors import InputError
+    from .sensitivity import allowable as compute, manoeuvre_from_dict, margins
+    from .summary import margin_summary
+    from mechanics.budget import budget as make_budget
+    from mechanics.mount import mount_from_dict
+
+    if basis not in ("rss", "worst"):
+        raise InputError("choose rss or worst", "--basis")
+    b = make_budget(mount_from_dict(fileio.read_toml(mount), str(mount), mount.parent))
+    allow = compute(manoeuvre_from_dict(fileio.read_toml(manoeuvre), str(manoeuvre), manoeuvre.parent))
+    rows = margins(b.elements(basis), allow)
+    typer.echo(margin_summary(rows, basis))
+    if json_out is not None:
+        import math
+
+        fileio.write_json(json_out, {
+            "format": "imu-align.check", "version": 1, "convention": CONVENTION, "units": {"angles": "deg"},
+            "basis": basis, "pass": all(r.ok for r in rows),
+            "elements": [{"element": r.element, "predicted_deg": math.degrees(r.predicted),
+                          "allowed_deg": None if math.isinf(r.allowed) else math.degrees(r.allowed),
+                          "margin_deg": None if math.isinf(r.allowed) else math.degrees(r.margin),
+                          "pass": r.ok} for r in rows],
+        })
+    if not all(r.ok for r in rows):
+        raise typer.Exit(4)
+
+
 class _progress:
     """A progress bar on a terminal's stderr; silent when stderr is not a terminal."""
 
@@ -272,7 +328,7 @@ def main() -> None:
     from .errors import AlignError
 
     try:
-        app(standalone_mode=False)
+        code = app(standalone_mode=False)  # a typer.Exit(code) comes back as the return value here
     except AlignError as exc:
         typer.echo(f"imu-align: error: {exc}", err=True)
         sys.exit(exc.exit_code)
@@ -288,6 +344,8 @@ def main() -> None:
             raise
         typer.echo(f"imu-align: internal error: {type(exc).__name__}: {exc} (set IMU_ALIGN_DEBUG=1 for details)", err=True)
         sys.exit(1)
+    if isinstance(code, int) and code:
+        sys.exit(code)
 
 
 if __name__ == "__main__":

@@ -90,3 +90,37 @@ def budget_summary(b) -> str:
                      + f"   ({mc['draws']:,} draws, seed {mc['seed']})")
     lines += ["", f"  worst case over all axes {d['worst_case_deg']:.5f} deg; source total {d['total_deg']:.5f} deg"]
     return "\n".join(lines)
+
+
+def _deg(v: float) -> str:
+    return "unconstrained" if not np.isfinite(v) else f"{v / DEG:.4f}"
+
+
+def allowable_summary(a) -> str:
+    """The table ``imu-align allowable`` prints."""
+    lim = ", ".join(f"{k} {v / DEG:g} deg" for k, v in a.manoeuvre.limits.items())
+    lines = [f"Allowable misalignment for: {a.manoeuvre.description} (limits: {lim})", "",
+             "  element      allowable [deg]   method"]
+    for e, v in a.allowable.items():
+        lines.append(f"  {e:<10} {_deg(v):>17}   {a.method[e]}")
+    ag = a.agreement
+    lines += ["", f"  binding element: {a.binding} = {_deg(a.binding_value)} deg",
+              f"  largest rigid misalignment cone (any direction): {a.cone / DEG:.4f} deg",
+              "", f"  check at {ag['element']} = {ag['element_deg'] if ag['element_deg'] is None else round(ag['element_deg'], 6)} deg"
+              " (per-gyro integrated-angle error, deg):",
+              "    closed form (Eq 11-13)  " + "  ".join(f"{k}={v:+.6f}" for k, v in ag["closed_form_deg"].items()),
+              "    attitude propagation    " + "  ".join(f"{k}={v:+.6f}" for k, v in ag["propagated_deg"].items()),
+              f"    ({ag['note']})"]
+    return "\n".join(lines)
+
+
+def margin_summary(rows, basis: str) -> str:
+    """The table ``imu-align check`` prints."""
+    lines = [f"Budget ({basis}) against the allowance, element by element [deg]", "",
+             "  element     predicted      allowed       margin   result"]
+    for r in rows:
+        margin = "-" if not np.isfinite(r.allowed) else f"{r.margin / DEG:+.4f}"
+        lines.append(f"  {r.element:<10} {r.predicted / DEG:10.4f} {_deg(r.allowed):>13} {margin:>12}   {'pass' if r.ok else 'FAIL'}")
+    failed = [r.element for r in rows if not r.ok]
+    lines += ["", "  result: " + ("PASS" if not failed else f"FAIL ({', '.join(failed)})")]
+    return "\n".join(lines)

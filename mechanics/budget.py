@@ -72,6 +72,28 @@ class Budget:
     def worst_case(self) -> float:
         return float(self.worst_case_per_axis.max())
 
+    def elements(self, basis: str = "rss") -> dict:
+        """Predicted size of each misalignment element (rad), named as in the sensitivity module.
+
+        ``psi_i`` is the per-axis figure; ``phi_ij`` (gyro ``i`` leaning toward
+        axis ``j``) combines the mounting rotation about the third axis ``k``
+        (tilt x, tilt y or skew z) with the datasheet term of gyro ``i`` and the
+        extras; by RSS (``basis="rss"``) or added (``"worst"``).
+        """
+        if basis not in ("rss", "worst"):
+            raise ValueError("basis is rss or worst")
+        about = {0: self.tilt_x, 1: self.tilt_y, 2: self.skew_z}
+        extras = list(self.mount.extras.values())
+        out = {}
+        for i, a in enumerate("xyz"):
+            out[f"psi_{a}"] = float(self.per_axis[i] if basis == "rss" else self.worst_case_per_axis[i])
+            for j, b in enumerate("xyz"):
+                if i == j:
+                    continue
+                terms = [about[3 - i - j], self.mount.axis_to_package[i], *extras]
+                out[f"phi_{a}{b}"] = rss(*terms) if basis == "rss" else float(sum(terms))
+        return out
+
     def to_dict(self) -> dict:
         m = self.mount
         d = {
