@@ -300,6 +300,180 @@ def check(
         raise typer.Exit(4)
 
 
+@app.command()
+def allan(
+    logs: list[Path] = typer.Argument(..., help="Static recordings: .csv, .csv.gz or .npy; several runs give the bias repeatability."),
+    columns: str = typer.Option("gyro_x,gyro_y,gyro_z", help="Data columns (a CSV's time column is 'time' unless --rate-hz)."),
+    rate_hz: Optional[float] = typer.Option(None, help="Sample rate for files without a time column (.npy always)."),
+    gyro_units: str = typer.Option("deg/s", help="Unit of the data columns (an angular rate)."),
+    units: Optional[str] = typer.Option(None, help="Any rate or acceleration unit instead of --gyro-units (e.g. g)."),
+    grid: str = typer.Option("dense", help="dense | octave | decade | explicit taus '0.01,0.1,1' (s)."),
+    per_decade: int = typer.Option(10, help="Points per decade of the dense grid."),
+    modified: bool = typer.Option(False, help="Also the modified Allan deviation."),
+    json_out: Optional[Path] = typer.Option(None, "--json", help="Write the versioned JSON result here."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Log-log plot with confidence band and fit (PNG)."),
+    rate: Optional[str] = typer.Option(None, help="Table rate, to plan: draws the target and the averaging time."),
+    accuracy: Optional[str] = typer.Option(None, help="Alignment goal, to plan (with --rate)."),
+    noise_ratio: float = typer.Option(10.0, help="Noise this many times below the goal, to plan."),
+) -> None:
+    """Allan deviation, noise-model fit and noise figures of static recordings."""
+    import numpy as np
+
+    from . import fileio
+    from .errors import InputError
+    from .noisereport import allan_plot_png, run_allan
+    from .summary import allan_summary
+    from .units import parse_quantity as q
+    from .units import parse_unit
+
+    unit = units or gyro_units
+    parse_unit(unit, None if units else "angular_rate", "--units" if units else "--gyro-units")
+    if units and parse_unit(units).dim not in (parse_unit("rad/s").dim, parse_unit("m/s^2").dim):
+        raise InputError(f"'{units}' is neither an angular rate nor an acceleration", "--units")
+    names = [c.strip() for c in columns.split(",") if c.strip()]
+    grid_value = grid if grid in ("dense", "octave", "decade") else _taus(grid)
+    runs, fs = [], None
+    for log in logs:
+        data, f = _static_log(log, names, rate_hz)
+        if fs is not None and abs(f - fs) > 1e-9 * fs:
+            raise InputError(f"sample rate {f:g} Hz differs from the first run's {fs:g} Hz", str(log))
+        runs.append(data)
+        fs = f
+    with _progress(len(names), "Allan deviation") as tick:
+        job = run_allan(runs, fs, names, unit, grid_value, per_decade, modified, progress=tick)
+    job = type(job)(**{**job.__dict__, "inputs": [str(p) for p in logs]})
+    d = job.to_dict()
+    target = chosen = None
+    if (rate is None) != (accuracy is None):
+        raise InputError("give both --rate and --accuracy to plan", "--rate")
+    if rate is not None:
+        from .planner import make_plan
+
+        r = job.result
+        worst = r.adev.max(axis=0)
+        pl = make_plan(q(rate, "angular_rate", "--rate"), q(accuracy, "angle", "--accuracy"), noise_ratio,
+                       "measured curve (worst channel)", tau=r.tau, adev=worst)
+        target, chosen = pl.noise_target, pl.averaging.tau
+        d["plan"] = pl.to_dict()
+    typer.echo(allan_summary(d))
+    if "plan" in d:
+        from .summary import plan_summary
+
+        typer.echo("\n" + plan_summary(d["plan"]))
+    png = allan_plot_png(job, target, chosen) if plot is not None else None
+    if json_out is not None:
+        fileio.write_json(json_out, d)
+    if png is not None:
+        fileio.write_bytes(plot, png)
+
+
+def _taus(text: str) -> list[float]:
+    from .errors import InputError
+
+    try:
+        taus = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise InputError(f"'{text}' is not dense, octave, decade or a comma list of taus in seconds", "--grid") from None
+    if not taus or min(taus) <= 0:
+        raise InputError("taus must be positive seconds", "--grid")
+    return taus
+
+
+def _static_log(log: Path, names: list[str], rate_hz: Optional[float]):
+    """Raw columns of a static log (no unit conversion: the Allan deviation is scaled afterwards) and its rate."""
+    import numpy as np
+
+    from . import fileio
+    from .errors import InputError
+
+    if log.suffix.lower() == ".npy":
+        if rate_hz is None:
+            raise InputError("a .npy file has no time: give --rate-hz", str(log))
+        source = fileio.NpyChunks(log)
+        if source.shape[1] != len(names):
+            raise InputError(f"array of shape {source.shape} has {source.shape[1]} columns; name them all with --columns",
+                             str(log))
+        return source, float(rate_hz)
+    wanted = names if rate_hz is not None else ["time"] + names
+    got, data = fileio.read_columns(log, wanted)
+    if rate_hz is not None:
+        return data, float(rate_hz)
+    t = data[:, 0]
+    dt = np.diff(t)
+    if len(dt) < 2 or np.any(~np.isfinite(dt)) or np.any(dt <= 0):
+        raise InputError("time column is not increasing (or too short)", str(log))
+    med = float(np.median(dt))
+    gaps = np.flatnonzero(np.abs(dt - med) > 0.5 * med)
+    if len(gaps):
+        k = int(gaps[0])
+        raise InputError(f"{len(gaps)} time gaps or jitter over 50 % of the {med:.4g} s step (first at t={t[k]:.6g} s, "
+                         f"step {dt[k]:.4g} s); an Allan deviation needs uniform samples: resample or split the file", str(log))
+    return np.ascontiguousarray(data[:, 1:]), 1.0 / med
+
+
+@app.command()
+def plan(
+    rate: str = typer.Option(..., "--rate", help="Table rate, e.g. '100 deg/s'."),
+    accuracy: str = typer.Option(..., "--accuracy", help="Alignment goal, e.g. '0.1 deg'."),
+    noise_ratio: float = typer.Option(10.0, help="Noise this many times below the goal."),
+    arw: Optional[str] = typer.Option(None, help="Angle random walk, e.g. '0.3 deg/sqrt(h)'."),
+    bias_instability: Optional[str] = typer.Option(None, help="Bias instability, e.g. '6 deg/h' (with --arw)."),
+    rate_random_walk: Optional[str] = typer.Option(None, help="Rate random walk, e.g. '3 deg/h/sqrt(h)' (with --arw)."),
+    imu: Optional[str] = typer.Option(None, help="A datasheet preset (see 'budget'), e.g. ADIS16485."),
+    allan_json: Optional[Path] = typer.Option(None, "--allan", help="A result of 'imu-align allan --json'."),
+    turn_angle: str = typer.Option("360 deg", help="Turn of the angle method."),
+    settle: str = typer.Option("2 s", help="Settling time added to each step."),
+    steps: int = typer.Option(6, help="Table steps (6: +/- about three axes)."),
+    json_out: Optional[Path] = typer.Option(None, "--json", help="Write the versioned JSON result here."),
+) -> None:
+    """Averaging time per table step for an alignment goal (Example 3), and the whole plan."""
+    import numpy as np
+
+    from . import fileio
+    from .errors import InputError
+    from .planner import make_plan, model_curve
+    from .summary import plan_summary
+    from .units import parse_quantity as q
+    from .units import parse_unit
+
+    given = [x is not None for x in (arw, imu, allan_json)]
+    if sum(given) != 1:
+        raise InputError("give exactly one noise source: --arw X [--bias-instability Y], --imu PART or --allan RESULT.json", "plan")
+    if arw is None and (bias_instability or rate_random_walk):
+        raise InputError("goes with --arw", "--bias-instability" if bias_instability else "--rate-random-walk")
+    w, a = q(rate, "angular_rate", "--rate"), q(accuracy, "angle", "--accuracy")
+    if w <= 0 or a <= 0 or noise_ratio <= 0:
+        raise InputError("rate, accuracy and noise ratio must be positive", "--rate")
+    common = dict(turn_angle=q(turn_angle, "angle", "--turn-angle"), steps=steps, settle=q(settle, "time", "--settle"))
+    if arw is not None:
+        n = q(arw, "angle_random_walk", "--arw")
+        b = q(bias_instability, "angular_rate", "--bias-instability") if bias_instability else 0.0
+        k = q(rate_random_walk, "rate_random_walk", "--rate-random-walk") if rate_random_walk else 0.0
+        label = f"model: ARW {arw}" + (f", bias instability {bias_instability}" if b else "") + (f", RRW {rate_random_walk}" if k else "")
+        result = make_plan(w, a, noise_ratio, label, sigma=model_curve(n, b, k), **common)
+    elif imu is not None:
+        from .parts import get_part
+
+        part = get_part(imu, "--imu")
+        n = part.si("arw", "angle_random_walk") or part.si("noise_density", "angle_random_walk")
+        if n is None:
+            raise InputError(f"{part.name} has no angle random walk or noise density in the preset table", "--imu")
+        b = part.si("bias_instability", "angular_rate") or 0.0
+        result = make_plan(w, a, noise_ratio, f"datasheet preset {part.name}", sigma=model_curve(n, b), **common)
+    else:
+        d = fileio.read_json(allan_json)
+        if d.get("format") != "imu-align.allan":
+            raise InputError("not a result of 'imu-align allan --json'", str(allan_json))
+        factor = parse_unit(d["units"]["adev"], "angular_rate", f"{allan_json}: units.adev").factor
+        curves = np.array(list(d["adev"].values()), dtype=float) * factor
+        result = make_plan(w, a, noise_ratio, f"measured curve (worst of {', '.join(d['adev'])})",
+                           tau=np.array(d["tau"]), adev=curves.max(axis=0), **common)
+    out = result.to_dict()
+    typer.echo(plan_summary(out))
+    if json_out is not None:
+        fileio.write_json(json_out, out)
+
+
 class _progress:
     """A progress bar on a terminal's stderr; silent when stderr is not a terminal."""
 

@@ -8,7 +8,7 @@ never leaves a half-written output.
 
 Public names
 ------------
-read_columns, read_log, read_toml, read_json, write_json, write_text, write_bytes,
+read_columns, read_log, NpyChunks, read_toml, read_json, write_json, write_text, write_bytes,
 write_csv, c_header
 """
 
@@ -181,6 +181,52 @@ def read_log(
             raise InputError("no time column: give --rate-hz", str(path))
         t, values = np.arange(len(data)) / rate_hz, data
     return np.ascontiguousarray(t), values * factor
+
+
+class NpyChunks:
+    """Row chunks of a 2-D .npy file read with ``numpy.fromfile``: no memory map, bounded memory.
+
+    Attributes
+    ----------
+    shape : tuple
+        ``(n, C)`` of the stored array.
+    """
+
+    def __init__(self, path: str | Path) -> None:
+        p = _exists(path)
+        try:
+            with open(p, "rb") as fh:
+                version = np.lib.format.read_magic(fh)
+                read = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
+                shape, fortran, dtype = read(fh)
+                self.offset = fh.tell()
+        except (ValueError, OSError) as exc:
+            raise InputError(f"cannot read .npy ({exc})", str(path)) from None
+        if len(shape) == 1:
+            shape = (shape[0], 1)
+        if len(shape) != 2 or dtype.kind not in "fiu":
+            raise InputError(f"expected a numeric n x k array, got {dtype} of shape {shape}", str(path))
+        self.path, self.shape, self.fortran, self.dtype = p, shape, fortran, dtype
+
+    def chunks(self, rows: int = 1 << 20, columns: list[int] | None = None):
+        """Yield float64 arrays of up to ``rows`` rows (all columns, or the ones listed)."""
+        n, c = self.shape
+        cols = list(range(c)) if columns is None else columns
+        with open(self.path, "rb") as fh:
+            for start in range(0, n, rows):
+                k = min(rows, n - start)
+                if self.fortran:
+                    block = np.empty((k, len(cols)))
+                    for j, col in enumerate(cols):
+                        fh.seek(self.offset + (col * n + start) * self.dtype.itemsize)
+                        block[:, j] = np.fromfile(fh, self.dtype, k)
+                else:
+                    fh.seek(self.offset + start * c * self.dtype.itemsize)
+                    block = np.fromfile(fh, self.dtype, k * c).reshape(k, c)
+                    if columns is not None:
+                        block = block[:, cols]
+                    block = block.astype(np.float64, copy=False)
+                yield block
 
 
 def read_toml(path: str | Path) -> dict:

@@ -124,3 +124,49 @@ def margin_summary(rows, basis: str) -> str:
     failed = [r.element for r in rows if not r.ok]
     lines += ["", "  result: " + ("PASS" if not failed else f"FAIL ({', '.join(failed)})")]
     return "\n".join(lines)
+
+
+def allan_summary(d: dict) -> str:
+    """The table ``imu-align allan`` prints, from the job's JSON form."""
+    u = d["units"]
+    lines = [f"Allan deviation: {d['samples']:,} samples at {d['fs_hz']:g} Hz ({d['samples'] / d['fs_hz'] / 3600:.3g} h), "
+             f"{len(d['tau'])} taus, {d['runs']} run(s); {d['sensor']} data in {u['adev']}", ""]
+    for name, fit in d["fit"].items():
+        lines.append(f"  {name}")
+        for term, t in fit["terms"].items():
+            val = "-" if t["value"] is None or t["value"] == 0 else f"{t['value']:.4g}"
+            sig = "" if t["sigma"] is None else f" ± {t['sigma']:.2g}"
+            flag = "" if t["identifiable"] else "   (not identifiable)"
+            lines.append(f"    {term:<13} {val:>10}{sig:<10} {t['unit']:<14}{flag}")
+        r = fit["ieee_point_readouts"]
+        fmt = lambda v: "-" if v is None else f"{v:.4g}"  # noqa: E731
+        lines.append(f"    IEEE point readouts: N(tau=1 s) {fmt(r['N_at_tau_1s'])} {r['N_unit']}, "
+                     f"floor/0.664 {fmt(r['B_floor_over_0.664'])} {r['B_unit']}, K(tau=3 s) {fmt(r['K_at_tau_3s'])} {r['K_unit']}")
+        fig = d["figures"][name]
+        stab = ", ".join(f"{p}: {v:.4g}" for p, v in fig["bias_stability"].items())
+        lines.append(f"    bias {fig['bias']:.6g} {u['bias']}; bias stability ({stab}) {u['bias']}")
+        if "repeatability" in d:
+            lines.append(f"    bias repeatability over {d['runs']} runs: {d['repeatability'][name]:.4g} {u['bias']}")
+        for note in fit["notes"]:
+            lines.append(f"    note: {note}")
+        lines.append("")
+    return "\n".join(lines).rstrip()
+
+
+def plan_summary(d: dict) -> str:
+    """The text ``imu-align plan`` prints."""
+    tp = d["test_plan"]
+    lines = [f"Test plan: table rate {d['rate_deg_s']:g} deg/s, alignment goal {d['accuracy_deg']:g} deg, "
+             f"noise {d['noise_ratio']:g}x below it ({d['noise_source']})",
+             f"  noise target        {d['noise_target_deg_h']:.4f} deg/h  (rate x sin(goal) / ratio, Example 3)",
+             f"  curve floor         {d['floor_deg_h']:.4g} deg/h at tau {d['floor_tau_s']:.3g} s"]
+    if d["feasible"]:
+        lines.append(f"  averaging time      {d['averaging_time_s']:.4g} s per step  ({d['reason']})")
+        lines.append(f"  whole test          {tp['steps']} steps x ({d['averaging_time_s']:.4g} s + {tp['settle_s']:g} s settling) = "
+                     f"{tp['total_table_time_s']:.4g} s of table time")
+    else:
+        lines.append(f"  averaging time      none: {d['reason']}")
+    turn = d["angle_method"]["longest_turn_s"]
+    lines.append(f"  angle method        turns of {d['angle_method']['turn_angle_deg']:g} deg must last at most "
+                 + ("(none meets it)" if turn is None else f"{turn:.4g} s"))
+    return "\n".join(lines)

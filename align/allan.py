@@ -1,0 +1,278 @@
+"""Overlapping and modified Allan deviation of many channels, with confidence intervals.
+
+For rate samples ``y`` at ``fs`` the phase is ``x = [0, cumsum(y - mean(y)) / fs]``
+(the mean is removed before the sum, as allantools does, to keep precision) and
+
+    AVAR(m tau0)  = sum_i (x[i+2m] - 2 x[i+m] + x[i])^2 / (2 (m tau0)^2 (N - 2m))
+    MVAR(m tau0)  = sum_j (sum_{i=j}^{j+m-1} (x[i+2m] - 2 x[i+m] + x[i]))^2 / (2 m^2 (m tau0)^2 (N - 3m + 1))
+
+(N phase points; IEEE Std 1139 / Riley, NIST SP 1065). The sums run in a
+compiled kernel (numba; tiled over blocks of the record, parallel, vectorised),
+with no temporaries the size of the record; the phase is built in place, and a record
+larger than ``memory_limit`` bytes keeps its phase in a temporary file
+(``numpy.memmap``), so 1e8-sample recordings run in bounded memory.
+
+Confidence intervals use the equivalent degrees of freedom of Howe's simple
+formulas for the overlapping estimator (NIST SP 1065 Table 5) with the noise
+type dominant at each tau, and chi-square quantiles.
+
+Public names
+------------
+tau_grid, AllanResult, allan, ArrayChunks, window_stability, edf_overlapping, confidence_interval, NOISE_ALPHA
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import InputError
+
+#: power-law exponent alpha of the frequency PSD (S_y ~ f^alpha) for each noise term
+NOISE_ALPHA = {"quantization": 2, "white": 0, "flicker": -1, "random_walk": -2, "ramp": -2}
+
+
+def tau_grid(n: int, fs: float, grid: str | list = "dense", per_decade: int = 10) -> np.ndarray:
+    """Averaging factors ``m`` (samples) for a record of ``n`` rate samples.
+
+    Parameters
+    ----------
+    grid : {"dense", "octave", "decade"} or list of float
+        ``dense``: log-spaced, ``per_decade`` points per decade; ``octave``:
+        powers of two; ``decade``: 1, 2, 4 x 10^k; a list: explicit taus in seconds.
+    Returns
+    -------
+    ndarray of int64, strictly increasing, ``1 <= m <= (n - 1) // 2``.
+    """
+    m_max = (n - 1) // 2  # at least two second differences behind every point
+    if m_max < 1:
+        raise InputError(f"only {n} samples: an Allan deviation needs at least 3")
+    if isinstance(grid, str):
+        if grid == "dense":
+            k = np.arange(0, int(np.floor(np.log10(m_max) * per_decade)) + 1)
+            m = np.round(10.0 ** (k / per_decade))
+        elif grid == "octave":
+            m = 2.0 ** np.arange(0, int(np.floor(np.log2(m_max))) + 1)
+        elif grid == "decade":
+            m = np.array([d * 10.0**e for e in range(0, int(np.log10(m_max)) + 1) for d in (1, 2, 4)])
+        else:
+            raise InputError(f"unknown grid '{grid}'; use dense, octave, decade or a list of taus", "--grid")
+    else:
+        m = np.round(np.asarray(grid, dtype=float) * fs)
+    m = np.unique(m[(m >= 1) & (m <= m_max)]).astype(np.int64)
+    if len(m) == 0:
+        raise InputError("no tau of the grid fits the record", "--taus")
+    return m
+
+
+def _get_kernels():
+    """The compiled ``avar_sums`` and ``mvar_sums`` (numba is imported only when needed)."""
+    from ._allan_kernels import avar_sums, mvar_sums
+
+    return avar_sums, mvar_sums
+
+
+class ArrayChunks:
+    """Row chunks of an in-memory (n, C) array, with the interface of :class:`align.fileio.NpyChunks`."""
+
+    def __init__(self, data) -> None:
+        arr = np.asarray(data)
+        self.data = arr.reshape(-1, 1) if arr.ndim == 1 else arr
+        self.shape = self.data.shape
+
+    def chunks(self, rows: int = 1 << 20, columns: list[int] | None = None):
+        cols = list(range(self.shape[1])) if columns is None else columns
+        for start in range(0, self.shape[0], rows):
+            yield np.asarray(self.data[start : start + rows, cols], dtype=np.float64)
+
+
+def _phases(source, fs: float, memory_limit: float, names) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Phases ``[0, cumsum(y - c) / fs]`` of every column in one pass, shape (C, n + 1).
+
+    ``c`` is the mean of the first chunk (the whole column when it fits one
+    chunk, as allantools does): removing a constant near the mean keeps the
+    running sum small and precise, and any constant cancels exactly in the
+    second differences. The running sums carry across chunks, so each row
+    equals one ``numpy.cumsum`` over its column. Phases larger than
+    ``memory_limit`` bytes live in a temporary file (``numpy.memmap``) that is
+    gone once released. Returns the phases, the constants and the column means.
+    """
+    n, c = source.shape
+    if c * (n + 1) * 8 > memory_limit:
+        fd, path = tempfile.mkstemp(prefix="imu_align_phase_", suffix=".f8")
+        os.close(fd)
+        x = np.memmap(path, dtype=np.float64, mode="w+", shape=(c, n + 1))
+        os.unlink(path)  # the mapping keeps the file alive; nothing is left behind
+    else:
+        x = np.empty((c, n + 1))
+    x[:, 0] = 0.0
+    pos, carry, total, const = 1, np.zeros(c), np.zeros(c), None
+    for chunk in source.chunks():
+        k = len(chunk)
+        bad = ~np.isfinite(chunk)
+        if bad.any():
+            row, col = np.argwhere(bad)[0]
+            raise InputError(f"NaN or infinite sample (first at sample {pos - 1 + row}); repair or cut the record",
+                             names[col])
+        if const is None:
+            const = np.array([np.mean(chunk[:, j]) for j in range(c)])
+        for j in range(c):
+            seg = x[j, pos : pos + k]
+            np.subtract(chunk[:, j], const[j], out=seg)
+            total[j] += np.sum(seg)
+            seg[0] += carry[j]
+            np.cumsum(seg, out=seg)
+            carry[j] = seg[-1]
+        pos += k
+    x[:, 1:] *= 1.0 / fs
+    return x, const, const + total / n
+
+
+def window_stability(x: np.ndarray, fs: float, period: float) -> float:
+    """Seed 002 Eq 7 from the phase: std (ddof 1) of the means of consecutive ``period``-second windows.
+
+    A window mean is ``(x[(i+1) k] - x[i k]) fs / k`` plus the (removed) mean.
+    """
+    k = int(round(period * fs))
+    windows = (len(x) - 1) // k if k > 0 else 0
+    if windows < 2:
+        return float("nan")
+    edges = np.asarray(x[: windows * k + 1 : k])
+    return float(np.std(np.diff(edges) * fs / k, ddof=1))
+
+
+def edf_overlapping(n_phase: int, m: np.ndarray, alpha: np.ndarray) -> np.ndarray:
+    """Equivalent degrees of freedom of the overlapping ADEV (Howe's simple formulas, SP 1065 Table 5).
+
+    Parameters
+    ----------
+    n_phase : int
+        Number of phase points ``N``.
+    m : ndarray
+        Averaging factors.
+    alpha : ndarray
+        Noise exponent at each tau (2 white PM, 1 flicker PM, 0 white FM, -1 flicker FM, -2 RW FM).
+    """
+    N = float(n_phase)
+    m = np.asarray(m, dtype=float)
+    alpha = np.broadcast_to(alpha, m.shape)
+    out = np.empty_like(m)
+    for k, (mm, a) in enumerate(zip(m, alpha)):
+        if a == 2:
+            e = (N + 1) * (N - 2 * mm) / (2 * (N - mm))
+        elif a == 1:
+            e = np.exp(np.sqrt(np.log((N - 1) / (2 * mm)) * np.log((2 * mm + 1) * (N - 1) / 4)))
+        elif a == 0:
+            e = (3 * (N - 1) / (2 * mm) - 2 * (N - 2) / N) * 4 * mm**2 / (4 * mm**2 + 5)
+        elif a == -1:
+            e = 2 * (N - 2) / (2.3 * N - 4.9) if mm == 1 else 5 * N**2 / (4 * mm * (N + 3 * mm))
+        else:
+            e = (N - 2) / mm * ((N - 1) ** 2 - 3 * mm * (N - 1) + 4 * mm**2) / (N - 3) ** 2
+        out[k] = max(e, 1.0)
+    return out
+
+
+def confidence_interval(dev: np.ndarray, edf: np.ndarray, level: float = 0.682689492137086) -> tuple[np.ndarray, np.ndarray]:
+    """Chi-square interval of a deviation: ``dev sqrt(edf / chi2_{(1 +/- level)/2}(edf))``.
+
+    The chi-square quantile is ``2 gammaincinv(edf / 2, q)`` (scipy.special; lighter than scipy.stats).
+    """
+    from scipy.special import gammaincinv
+
+    lo = dev * np.sqrt(edf / (2 * gammaincinv(edf / 2, 0.5 + level / 2)))
+    hi = dev * np.sqrt(edf / (2 * gammaincinv(edf / 2, 0.5 - level / 2)))
+    return lo, hi
+
+
+@dataclass(frozen=True)
+class AllanResult:
+    """Allan deviation of several channels (in the unit of the input, e.g. rad/s).
+
+    Attributes
+    ----------
+    tau : ndarray, shape (T,)
+        s.
+    m : ndarray, shape (T,)
+        Averaging factors.
+    adev : ndarray, shape (C, T)
+    mdev : ndarray or None, shape (C, T)
+    n : int
+        Samples per channel.
+    fs : float
+    names : tuple of str
+    bias : ndarray, shape (C,)
+        Mean of each channel (seed 002 Eq 5).
+    stability : dict
+        Period (s) -> ndarray (C,): bias stability (seed 002 Eq 7).
+    """
+
+    tau: np.ndarray
+    m: np.ndarray
+    adev: np.ndarray
+    mdev: np.ndarray | None
+    n: int
+    fs: float
+    names: tuple
+    bias: np.ndarray | None = None
+    stability: dict | None = None
+
+    @property
+    def n_phase(self) -> int:
+        return self.n + 1
+
+    def scaled(self, factor: float) -> "AllanResult":
+        """The same result with the data unit scaled by ``factor`` (deviations are linear in it)."""
+        return AllanResult(self.tau, self.m, self.adev * factor, None if self.mdev is None else self.mdev * factor,
+                           self.n, self.fs, self.names, None if self.bias is None else self.bias * factor,
+                           None if self.stability is None else {p: v * factor for p, v in self.stability.items()})
+
+
+def allan(data, fs: float, names=None, grid="dense", per_decade: int = 10, modified: bool = False,
+          memory_limit: float = 2e9, progress=None, periods=(1.0, 10.0)) -> AllanResult:
+    """Overlapping (and optionally modified) Allan deviation of each column, and the seed's figures.
+
+    Parameters
+    ----------
+    data : array_like, shape (n,) or (n, C), or a chunk source
+        Rate samples, uniform in time; an in-memory array or an object with
+        ``shape`` and ``chunks(rows, columns)`` such as :class:`align.fileio.NpyChunks`
+        (read twice per channel, never whole).
+    fs : float
+        Sample rate, Hz.
+    names : sequence of str, optional
+    grid, per_decade : see :func:`tau_grid`
+    modified : bool
+        Also compute the modified Allan deviation.
+    memory_limit : float
+        Bytes of phase kept in memory; a larger phase goes to a temporary file.
+    progress : callable, optional
+        Called with the number of channels done (once, at the end).
+    periods : sequence of float
+        Averaging periods (s) of the bias stability.
+
+    Raises
+    ------
+    InputError
+        NaN or infinite samples (the first one is named).
+    """
+    source = data if hasattr(data, "chunks") else ArrayChunks(data)
+    n, c = source.shape
+    names = tuple(names) if names is not None else tuple(f"col{j}" for j in range(c))
+    m = tau_grid(n, fs, grid, per_decade)
+    avar_sums, mvar_sums = _get_kernels()
+    tau = m / fs
+    x, _, means = _phases(source, fs, memory_limit, names)
+    adev = np.sqrt(avar_sums(x, m) / (2.0 * tau**2 * (n + 1 - 2 * m)))
+    mdev = None
+    if modified:
+        mdev = np.full((c, len(m)), np.nan)
+        mm = m[3 * m <= n + 1]
+        mdev[:, : len(mm)] = np.sqrt(mvar_sums(x, mm) / (2.0 * mm.astype(float) ** 2 * (mm / fs) ** 2 * (n + 1 - 3 * mm + 1)))
+    stability = {p: np.array([window_stability(x[j], fs, p) for j in range(c)]) for p in periods}
+    del x
+    if progress is not None:
+        progress(c)
+    return AllanResult(tau, m, adev, mdev, n, fs, names, means, stability)
