@@ -165,8 +165,10 @@ def test_allan_cli_on_real_adis16405_and_plan_from_it(tmp_path, run_cli):
         assert n_fit == pytest.approx(n_read, rel=0.15)  # the fit and the IEEE readout agree
         lo, hi, a = (np.array(d[k][name]) for k in ("ci_low", "ci_high", "adev"))
         assert np.all(lo <= a) and np.all(a <= hi)
-        # the curve floor against the datasheet's in-run bias stability, 0.007 deg/s = 25.2 deg/h
-        assert 15 < a.min() * 3600 < 50
+        # the curve floor (taus up to a tenth of the record, where the interval is tight) against
+        # the datasheet's in-run bias stability, 0.007 deg/s = 25.2 deg/h
+        reliable = np.array(d["tau"]) <= 1000.0
+        assert 15 < a[reliable].min() * 3600 < 50
     # repeatability of two runs is |b1 - b2| / sqrt(2): check against the per-run means
     import pandas as pd
 
