@@ -111,28 +111,68 @@ def matrix(
 @app.command()
 def apply(
     log: Path = typer.Argument(..., help="Log to correct."),
-    alignment: Path = typer.Option(..., "--alignment", help="Result JSON from 'imu-align matrix'."),
+    alignment: Path = typer.Option(..., "--alignment", help="A result of 'matrix', 'calibrate ferraris/accel' or 'calibrate mag'."),
     out: Path = typer.Option(..., "--out", help="Corrected CSV (same columns and units)."),
+    sensor: Optional[str] = typer.Option(None, help="accelerometer | gyroscope, for a file holding both."),
     gyro_units: str = typer.Option("deg/s", help="Unit of the gyro columns."),
-    columns: str = typer.Option(DEFAULT_COLUMNS, help="Column names: time,x,y,z (x,y,z with --rate-hz)."),
+    units: Optional[str] = typer.Option(None, help="Unit of the columns for an accelerometer or magnetometer result."),
+    columns: Optional[str] = typer.Option(None, help="Column names: time,x,y,z (x,y,z with --rate-hz); default per sensor."),
     rate_hz: Optional[float] = typer.Option(None, help="Sample rate for a log without a time column."),
 ) -> None:
-    """Correct a log: w = A (g - b), written in the log's own units."""
+    """Correct a log: gyro w = A (g - b); accelerometer M^-1 (a - b); magnetometer soft_iron (m - hard_iron)."""
     import numpy as np
 
     from . import fileio
+    from .alignment import FORMAT as ALIGN_FORMAT
     from .alignment import AlignmentResult
+    from .calibration import Calibration
+    from .errors import InputError
+    from .magnetometer import MagCalibration
     from .model import SensorModel
-    from .units import to_unit
+    from .units import parse_unit, to_unit
 
-    result = AlignmentResult.from_dict(fileio.read_json(alignment), str(alignment))
-    time_col, cols = _columns(columns, rate_hz)
-    t, g = fileio.read_log(log, cols, gyro_units, time_col, rate_hz)
-    w = SensorModel(result.M, result.bias).correct(g)
+    d = fileio.read_json(alignment)
+    fmt = d.get("format")
+    defaults = {"gyroscope": "time,gyro_x,gyro_y,gyro_z", "accelerometer": "time,acc_x,acc_y,acc_z",
+                "magnetometer": "time,mag_x,mag_y,mag_z"}
+    if fmt == ALIGN_FORMAT:
+        kind, u = "gyroscope", gyro_units
+        model = AlignmentResult.from_dict(d, str(alignment))
+        correct = SensorModel(model.M, model.bias).correct
+    elif fmt == "imu-align.calibration":
+        present = [k for k in ("accelerometer", "gyroscope") if k in d]
+        kind = sensor or (present[0] if len(present) == 1 else None)
+        if kind not in present:
+            raise InputError(f"this file holds {', '.join(present)}: choose one with --sensor", "--sensor")
+        cal = Calibration.from_dict(d[kind], f"{alignment}: {kind}")
+        u = units or (gyro_units if kind == "gyroscope" else cal.units)
+        correct = cal.correct
+    elif fmt == "imu-align.magnetometer":
+        kind = "magnetometer"
+        cal = MagCalibration.from_dict(d, str(alignment))
+        u = units or cal.units
+        correct = cal.correct
+    else:
+        raise InputError(f"not an imu-align result (format {fmt!r})", str(alignment))
+    expect = {"gyroscope": "angular_rate", "accelerometer": None, "magnetometer": None}[kind]
+    parse_unit(u, expect, "--units")
+    time_col, cols = _columns(columns or defaults[kind], rate_hz)
+    t, raw = fileio.read_log(log, cols, u, time_col, rate_hz, expect=expect or _kind_of(u))
+    w = correct(raw)
     names = ([time_col] if time_col else []) + cols
-    data = np.column_stack(([t] if time_col else []) + [to_unit(w, gyro_units)])
+    data = np.column_stack(([t] if time_col else []) + [to_unit(w, u)])
     fileio.write_csv(out, names, data)
-    typer.echo(f"wrote {out}: {len(t)} rows corrected with A from {alignment} (w = A (g - b), {gyro_units})")
+    typer.echo(f"wrote {out}: {len(t)} rows of {kind} data corrected with {alignment} ({u})")
+
+
+def _kind_of(unit: str) -> str:
+    from .units import DIMENSIONS, parse_unit
+
+    dim = parse_unit(unit).dim
+    for name in ("acceleration", "magnetic_field", "counts", "angular_rate"):
+        if DIMENSIONS[name][0].dim == dim:
+            return name
+    return "dimensionless"
 
 
 @app.command()
@@ -529,6 +569,205 @@ def demo(
     typer.echo("imu-align demo (inputs: the reference's Examples 1-3, a simulated static record and rate-table session)\n"
                + summary + f"\nalignment error against the simulation's truth: {err:.1e} (largest element of M)"
                + f"\nwrote {out}/report.html and the JSON results beside it")
+
+
+calibrate_app = typer.Typer(help="Sensor calibration: Ferraris sessions, accelerometer positions, magnetometer ellipsoid.",
+                            no_args_is_help=True)
+app.add_typer(calibrate_app, name="calibrate")
+
+
+def _calibration_file(sensors: dict, inputs: dict) -> dict:
+    from . import __version__
+    from .calibration import CONVENTION
+
+    d = {"format": "imu-align.calibration", "version": 1, "generator": f"imu-align {__version__}",
+         "convention": CONVENTION, "inputs": inputs}
+    d.update({k: v.to_dict() for k, v in sensors.items()})
+    return d
+
+
+@calibrate_app.command("ferraris")
+def calibrate_ferraris(
+    log: Path = typer.Argument(..., help="Session log (CSV) with accelerometer and gyro columns."),
+    sections: Path = typer.Option(..., "--sections", help="imucal section list JSON: x_p ... z_a, x_rot, y_rot, z_rot."),
+    rate_hz: float = typer.Option(..., "--rate-hz", help="Sample rate."),
+    turn_angle: str = typer.Option("-360 deg", help="Signed angle of each turn about the axis pointing up."),
+    gravity: str = typer.Option("9.80665 m/s^2", help="Local gravity."),
+    acc_columns: str = typer.Option("acc_x,acc_y,acc_z", help="Accelerometer columns."),
+    gyr_columns: str = typer.Option("gyr_x,gyr_y,gyr_z", help="Gyro columns."),
+    acc_units: str = typer.Option("m/s^2", help="Accelerometer unit."),
+    gyr_units: str = typer.Option("deg/s", help="Gyro unit."),
+    bias: str = typer.Option("pairwise", help="Accelerometer bias: pairwise (Ferraris, tilt-robust) or lsq."),
+    g_sensitivity: bool = typer.Option(True, help="Estimate the gyro's g-sensitivity from the static faces."),
+    json_out: Optional[Path] = typer.Option(None, "--json", help="Write the versioned JSON result here."),
+    imucal_json: Optional[Path] = typer.Option(None, "--imucal-json", help="Also write the result as imucal's JSON."),
+) -> None:
+    """A Ferraris session (six static faces and a turn about each axis), as imucal records it."""
+    import numpy as np
+
+    from . import fileio
+    from .calibration import ferraris, imucal_dict
+    from .errors import InputError
+    from .summary import calibration_summary
+    from .units import parse_quantity as q
+
+    if bias not in ("pairwise", "lsq"):
+        raise InputError("choose pairwise or lsq", "--bias")
+    acc_names = [c.strip() for c in acc_columns.split(",")]
+    gyr_names = [c.strip() for c in gyr_columns.split(",")]
+    _, acc = fileio.read_log(log, acc_names, acc_units, None, rate_hz, expect="acceleration")
+    _, gyr = fileio.read_log(log, gyr_names, gyr_units, None, rate_hz)
+    raw = fileio.read_json(sections)
+    try:
+        secs = {k: (int(v["start"]), int(v["end"])) for k, v in raw.items()}
+    except (KeyError, TypeError, ValueError):
+        raise InputError("each section needs integer start and end", str(sections)) from None
+    acc_cal, gyr_cal = ferraris(acc, gyr, rate_hz, secs, q(turn_angle, "angle", "--turn-angle"),
+                                q(gravity, "acceleration", "--gravity"), acc_units, gyr_units,
+                                pairwise_bias=bias == "pairwise", g_sensitivity=g_sensitivity)
+    typer.echo(calibration_summary({"accelerometer": acc_cal, "gyroscope": gyr_cal}))
+    if json_out is not None:
+        fileio.write_json(json_out, _calibration_file({"accelerometer": acc_cal, "gyroscope": gyr_cal},
+                                                      {"log": str(log), "sections": str(sections)}))
+    if imucal_json is not None:
+        fileio.write_json(imucal_json, imucal_dict(acc_cal, gyr_cal))
+
+
+@calibrate_app.command("accel")
+def calibrate_accel_cmd(
+    log: Path = typer.Argument(..., help="Accelerometer log: static positions separated by moves."),
+    positions: Optional[Path] = typer.Option(None, "--positions", help="Positions TOML ([[position]] up, start/end, holdout); "
+                                             "without it the orientations are unknown and |a| = g is fitted."),
+    columns: str = typer.Option("time,acc_x,acc_y,acc_z", help="Columns: time,x,y,z (x,y,z with --rate-hz)."),
+    rate_hz: Optional[float] = typer.Option(None, help="Sample rate for a log without a time column."),
+    units: str = typer.Option("m/s^2", help="Unit of the readings (an acceleration, or 'counts')."),
+    gravity: Optional[str] = typer.Option(None, help="Local gravity (default 9.80665 m/s^2, or the positions file's)."),
+    window: str = typer.Option("1 s", help="Variance window of the static detector."),
+    factor: float = typer.Option(6.0, help="Static threshold: this many times the quiet variance."),
+    init_static: Optional[str] = typer.Option(None, help="Initial static period for the threshold (imu_tk), e.g. '50 s'."),
+    min_static: str = typer.Option("1 s", help="Shortest static interval."),
+    json_out: Optional[Path] = typer.Option(None, "--json", help="Write the versioned JSON result here."),
+) -> None:
+    """Accelerometer multi-position calibration (known orientations, or |a| = g over many attitudes)."""
+    import numpy as np
+
+    from . import fileio
+    from .calibration import calibrate_accel, calibrate_accel_free
+    from .errors import InputError, TestError
+    from .plan import parse_axis
+    from .segment import static_intervals
+    from .summary import calibration_summary
+    from .units import STANDARD_GRAVITY, parse_unit
+    from .units import parse_quantity as q
+
+    time_col, cols = _columns(columns, rate_hz)
+    counts = parse_unit(units).dim == parse_unit("counts").dim
+    t, a = fileio.read_log(log, cols, units, time_col, rate_hz, expect="counts" if counts else "acceleration")
+    fs = 1.0 / float(np.median(np.diff(t)))
+    spec = fileio.read_toml(positions) if positions is not None else {}
+    g = q(gravity or spec.get("gravity", "9.80665 m/s^2"), "acceleration", "--gravity" if gravity else f"{positions}: gravity")
+    bad = ~np.isfinite(a).all(axis=1)
+    if bad.any():
+        raise InputError(f"{int(bad.sum())} rows with NaN (first at data row {int(np.flatnonzero(bad)[0]) + 1})", str(log))
+    intervals = static_intervals(a, fs, q(window, "time", "--window"), factor,
+                                 q(init_static, "time", "--init-static") if init_static else None, q(min_static, "time", "--min-static"))
+    if positions is None:
+        if counts:
+            scale = None
+        means = np.array([a[s:e].mean(axis=0) for s, e in intervals])
+        cal = calibrate_accel_free(means, g, units)
+        note = f"{len(intervals)} static intervals detected automatically (moving variance, factor {factor:g})"
+        cal = type(cal)(**{**cal.__dict__, "notes": cal.notes + (note,)})
+    else:
+        items = spec.get("position")
+        if not isinstance(items, list) or not items:
+            raise InputError("no [[position]] tables", str(positions))
+        if all("start" in p for p in items):
+            ranges = [(int(p["start"]), int(p["end"])) for p in items]
+        elif any("start" in p for p in items):
+            raise InputError("give start/end for every position or for none (automatic detection)", str(positions))
+        else:
+            if len(intervals) != len(items):
+                found = "; ".join(f"t={t[s]:.1f}-{t[e - 1]:.1f} s" for s, e in intervals[:20])
+                raise TestError(f"{len(intervals)} static intervals detected but {len(items)} positions listed ({found}); "
+                                "adjust --factor/--window or give start/end per position", str(log))
+            ranges = intervals
+        means, ups, hold, noise = {}, {}, [], {}
+        for k, (p, (s, e)) in enumerate(zip(items, ranges), start=1):
+            name = str(p.get("name", f"position {k}"))
+            up = p.get("up")
+            if isinstance(up, str):
+                axis, sign = parse_axis(up, f"{positions}: {name}.up")
+                u = np.zeros(3)
+                u[axis] = sign
+            elif isinstance(up, list) and len(up) == 3:
+                u = np.asarray(up, float)
+                u = u / np.linalg.norm(u)
+            else:
+                raise InputError("up must be an axis ('+x') or a vector [x, y, z]", f"{positions}: {name}.up")
+            if not 0 <= s < e <= len(a):
+                raise InputError(f"samples {s}..{e} are outside the log", f"{positions}: {name}")
+            seg = a[s:e]
+            spread = float(np.std(seg, axis=0).max())
+            if spread > 0.02 * g * (1 if not counts else np.median(np.linalg.norm(a, axis=1)) / g):
+                raise TestError(f"not static: the readings vary by {spread:.3g} (1 sigma) over samples {s}..{e}", name)
+            means[name], ups[name] = seg.mean(axis=0), u
+            if p.get("holdout"):
+                hold.append(name)
+        cal = calibrate_accel(means, ups, g, units, tuple(hold))
+    typer.echo(calibration_summary({"accelerometer": cal}))
+    if json_out is not None:
+        fileio.write_json(json_out, _calibration_file({"accelerometer": cal}, {"log": str(log),
+                                                                              "positions": None if positions is None else str(positions)}))
+
+
+@calibrate_app.command("mag")
+def calibrate_mag(
+    log: Path = typer.Argument(..., help="Magnetometer capture while tumbling the device (CSV or blank-separated text)."),
+    columns: str = typer.Option("mag_x,mag_y,mag_z", help="Magnetometer columns (col0,col1,... for a file without header)."),
+    mag_units: str = typer.Option("uT", help="Unit: uT, nT, gauss, mG, 'counts', or the size of one count, e.g. '0.92 mG'."),
+    field: Optional[str] = typer.Option(None, help="Known field strength to refine to, e.g. '48.5 uT'."),
+    model: str = typer.Option("symmetric", help="sphere | diagonal | symmetric soft iron."),
+    accel_columns: Optional[str] = typer.Option(None, help="Simultaneous accelerometer columns (dip angle, alignment to gravity)."),
+    dip: Optional[str] = typer.Option(None, help="Magnetic dip for the heading-error prediction when no accelerometer."),
+    json_out: Optional[Path] = typer.Option(None, "--json", help="Write the versioned JSON result here."),
+) -> None:
+    """Magnetometer hard and soft iron (ellipsoid fit with coverage gates)."""
+    import numpy as np
+
+    from . import fileio
+    from .errors import InputError
+    from .magnetometer import alignment_to_gravity, calibrate_magnetometer
+    from .summary import magnetometer_summary
+    from .units import parse_quantity, parse_unit
+
+    names = [c.strip() for c in columns.split(",")]
+    if mag_units[:1].isdigit() or mag_units[:1] == ".":
+        factor, shown = parse_quantity(mag_units, "magnetic_field", "--mag-units"), "uT"
+    else:
+        unit = parse_unit(mag_units, where="--mag-units")
+        if unit.dim not in (parse_unit("T").dim, parse_unit("counts").dim):
+            raise InputError(f"'{mag_units}' is not a magnetic field unit or 'counts'", "--mag-units")
+        factor, shown = unit.factor, mag_units
+    wanted = names + ([c.strip() for c in accel_columns.split(",")] if accel_columns else [])
+    _, data = fileio.read_columns(log, wanted)
+    m = data[:, :3] * factor
+    acc = data[:, 3:6] if accel_columns else None
+    f = None
+    if field is not None:
+        f = parse_quantity(field, "magnetic_field", "--field") if shown != "counts" else parse_quantity(field, "counts", "--field")
+    d = parse_quantity(dip, "angle", "--dip") if dip else None
+    cal = calibrate_magnetometer(m, shown, f, model, acc, d)
+    if acc is not None:
+        rot, dip_fit, scatter = alignment_to_gravity(cal.correct(m), acc)
+        cal = type(cal)(**{**cal.__dict__, "misalignment": rot,
+                           "notes": cal.notes + (f"rotation to the accelerometer frame from gravity: dip {np.degrees(dip_fit):.2f} deg, "
+                                                 f"scatter {np.degrees(scatter):.2f} deg after alignment",)})
+    typer.echo(magnetometer_summary(cal))
+    if json_out is not None:
+        out = cal.to_dict()
+        out["inputs"] = {"log": str(log), "columns": columns, "mag_units": mag_units}
+        fileio.write_json(json_out, out)
 
 
 class _progress:

@@ -150,7 +150,7 @@ def condition_number(phi: np.ndarray) -> float:
     return float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
 
 
-def fit_lsq(obs: list[Observation], rate_accuracy: float = 0.0, method: str = "lsq") -> Fit:
+def fit_lsq(obs: list[Observation], rate_accuracy: float = 0.0, method: str = "lsq", equal_weights: bool = False) -> Fit:
     """General weighted least squares for ``[M | b]`` (extends Eq 28-31).
 
     Each gyro ``i`` is fitted separately: minimise
@@ -160,7 +160,9 @@ def fit_lsq(obs: list[Observation], rate_accuracy: float = 0.0, method: str = "l
     drift); a stated table rate accuracy adds ``(M_ij rate_accuracy)^2``.
 
     Columns of ``M`` for axes never turned about are left NaN (the two-axis
-    shortcut fills them).
+    shortcut fills them). With ``equal_weights`` it is ordinary least squares,
+    ``K = Y X^T (X X^T)^-1`` (reference section 5), and the covariance is scaled
+    by the residual variance ``chi2 / dof`` alone.
 
     Raises
     ------
@@ -168,6 +170,8 @@ def fit_lsq(obs: list[Observation], rate_accuracy: float = 0.0, method: str = "l
         When the segments do not determine the turned columns and ``b``.
     """
     phi, y, var = _design(obs)
+    if equal_weights:
+        var = np.ones_like(var)
     k = len(obs)
     active = np.flatnonzero(np.linalg.norm(phi, axis=0) > 0)
     if np.linalg.matrix_rank(phi[:, active] / np.linalg.norm(phi[:, active], axis=0)) < len(active) or 3 not in active:
@@ -189,7 +193,10 @@ def fit_lsq(obs: list[Observation], rate_accuracy: float = 0.0, method: str = "l
         x[i, active] = sol
         resid[:, i] = y[:, i] - phi[:, active] @ sol
         chi2[i] = float(np.sum(resid[:, i] ** 2 * wts))
-        inflate = max(1.0, chi2[i] / dof) if dof > 0 else 1.0
+        if equal_weights:
+            inflate = chi2[i] / dof if dof > 0 else np.nan
+        else:
+            inflate = max(1.0, chi2[i] / dof) if dof > 0 else 1.0
         cov[i][sub] = np.linalg.inv(a.T @ a) * inflate
     m = x[:, :3]
     if rate_accuracy:

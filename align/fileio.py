@@ -77,6 +77,8 @@ def read_columns(path: str | Path, names: list[str] | None = None) -> tuple[list
         _require(names, schema_names, path)
         table = pq.read_table(p, columns=names)
         table = table.cast(pa.schema([(n, pa.float64()) for n in table.column_names]))
+    elif _is_whitespace_table(p):
+        return _whitespace_columns(p, names)
     elif suffixes.endswith((".csv", ".csv.gz", ".txt", ".txt.gz")) or p.suffix.lower() in (".csv", ".gz"):
         import pyarrow as pa
         import pyarrow.csv as pcsv
@@ -118,6 +120,35 @@ def _float_chunk(chunk) -> np.ndarray:
         bits = np.unpackbits(np.frombuffer(validity, dtype=np.uint8), bitorder="little")
         arr = np.where(bits[chunk.offset : chunk.offset + len(chunk)].astype(bool), arr, np.nan)
     return arr
+
+
+def _is_whitespace_table(p: Path) -> bool:
+    """A header-less text table of numbers separated by blanks (imu_tk's .mat text, ``x y z`` files)."""
+    if p.suffix.lower() in (".npy", ".parquet", ".gz"):
+        return False
+    with open(p, "rb") as fh:
+        first = fh.readline(4096).decode("ascii", "replace").strip()
+    if not first or "," in first or ";" in first:
+        return False
+    try:
+        [float(v) for v in first.split()]
+    except ValueError:
+        return False
+    return True
+
+
+def _whitespace_columns(p: Path, names: list[str] | None) -> tuple[list[str], np.ndarray]:
+    """Columns ``col0, col1, ...`` of a blank-separated numeric table (parsed in C by numpy)."""
+    text = p.read_text()
+    width = len(text.split("\n", 1)[0].split())
+    values = np.array(text.split(), dtype=float)
+    if values.size % width:
+        raise InputError(f"rows of unequal length (first row has {width} numbers)", str(p))
+    data = values.reshape(-1, width)
+    available = [f"col{i}" for i in range(width)]
+    _require(names, available, p)
+    idx = [available.index(n) for n in (names or available)]
+    return [available[i] for i in idx], data[:, idx]
 
 
 def _require(names: list[str] | None, available: list[str], path) -> None:

@@ -170,3 +170,37 @@ def plan_summary(d: dict) -> str:
     lines.append(f"  angle method        turns of {d['angle_method']['turn_angle_deg']:g} deg must last at most "
                  + ("(none meets it)" if turn is None else f"{turn:.4g} s"))
     return "\n".join(lines)
+
+
+def calibration_summary(cals: dict) -> str:
+    """Text for ``imu-align calibrate ferraris/accel``."""
+    out = []
+    for name, c in cals.items():
+        d = c.to_dict()
+        u = d["units"]["bias"]
+        out += [f"{name} ({d['method']}), convention {d['convention']}",
+                "  M (1-sigma):", matrix_text(c.M, c.sigma_M, 6, "    "),
+                f"  bias [{u}]: " + ", ".join(f"{b:+.6g} ± {s:.2g}" for b, s in zip(d["bias"], d["uncertainty"]["bias"]))]
+        if "g_sensitivity" in d:
+            out.append(f"  g-sensitivity [{d['units']['g_sensitivity']}]:")
+            out.append(matrix_text(np.array(d["g_sensitivity"]), None, 6, "    "))
+        if d["residuals"]:
+            worst = max(d["residuals"].items(), key=lambda kv: float(np.max(np.abs(kv[1]))))
+            out.append(f"  largest residual: {worst[0]} {np.max(np.abs(worst[1])):.3g} {u} ({len(d['residuals'])} positions)")
+        for k, v in d["checks"].items():
+            out.append(f"  held-out check {k}: residual {np.max(np.abs(v)):.3g} {u}")
+        out += [f"  note: {n}" for n in d["notes"]] + [""]
+    return "\n".join(out).rstrip()
+
+
+def magnetometer_summary(c) -> str:
+    """Text for ``imu-align calibrate mag``."""
+    d = c.to_dict()
+    u, q = d["units"]["hard_iron"], d["quality"]
+    lines = [f"magnetometer ({d['model']} soft iron), convention {d['convention']}",
+             f"  hard iron [{u}]: " + ", ".join(f"{h:+.5g} ± {s:.2g}" for h, s in zip(d["hard_iron"], d["uncertainty"]["hard_iron"])),
+             "  soft iron:", matrix_text(c.soft_iron, None, 5, "    "),
+             f"  field {d['field']:.5g} {u}; field-magnitude spread {100 * q['field_spread_before']:.2f} % before, "
+             f"{100 * q['field_spread_after']:.2f} % after; direction coverage {q['coverage']:.3f} (full sphere 0.333)",
+             f"  predicted heading error {q['predicted_heading_error_deg']:.2f} deg (1 sigma)"]
+    return "\n".join(lines + [f"  note: {n}" for n in d["notes"]])
