@@ -20,7 +20,7 @@ from .checks import (Check, check_directions, check_durations, check_log, check_
                      check_saturation, check_scale, check_span)
 from .earth import EARTH_RATE, vertical_rate
 from .errors import InputError
-from .estimate import (Fit, alignment_sigma, fit_angle_pairs, fit_lsq, fit_rate_pairs, observe,
+from .estimate import (alignment_sigma, fit_angle_pairs, fit_lsq, fit_rate_pairs, observe,
                        two_axis, two_axis_error_bound)
 from .model import angles, check_handedness
 from .plan import Plan

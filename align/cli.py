@@ -357,7 +357,6 @@ def allan(
     noise_ratio: float = typer.Option(10.0, help="Noise this many times below the goal, to plan."),
 ) -> None:
     """Allan deviation, noise-model fit and noise figures of static recordings."""
-    import numpy as np
 
     from . import fileio
     from .errors import InputError
@@ -550,7 +549,6 @@ def demo(
     out: Path = typer.Option(Path("imu-align-demo"), "--out", help="Folder for the inputs, results and report."),
 ) -> None:
     """The whole story on bundled inputs (Examples 1-3, simulated records): summary and report."""
-    import json
 
     from . import fileio
     from .story import build_report, demo_inputs
@@ -603,7 +601,6 @@ def calibrate_ferraris(
     imucal_json: Optional[Path] = typer.Option(None, "--imucal-json", help="Also write the result as imucal's JSON."),
 ) -> None:
     """A Ferraris session (six static faces and a turn about each axis), as imucal records it."""
-    import numpy as np
 
     from . import fileio
     from .calibration import ferraris, imucal_dict
@@ -657,7 +654,7 @@ def calibrate_accel_cmd(
     from .plan import parse_axis
     from .segment import static_intervals
     from .summary import calibration_summary
-    from .units import STANDARD_GRAVITY, parse_unit
+    from .units import parse_unit
     from .units import parse_quantity as q
 
     time_col, cols = _columns(columns, rate_hz)
@@ -672,8 +669,6 @@ def calibrate_accel_cmd(
     intervals = static_intervals(a, fs, q(window, "time", "--window"), factor,
                                  q(init_static, "time", "--init-static") if init_static else None, q(min_static, "time", "--min-static"))
     if positions is None:
-        if counts:
-            scale = None
         means = np.array([a[s:e].mean(axis=0) for s, e in intervals])
         cal = calibrate_accel_free(means, g, units)
         note = f"{len(intervals)} static intervals detected automatically (moving variance, factor {factor:g})"
@@ -692,7 +687,7 @@ def calibrate_accel_cmd(
                 raise TestError(f"{len(intervals)} static intervals detected but {len(items)} positions listed ({found}); "
                                 "adjust --factor/--window or give start/end per position", str(log))
             ranges = intervals
-        means, ups, hold, noise = {}, {}, [], {}
+        means, ups, hold = {}, {}, []
         for k, (p, (s, e)) in enumerate(zip(items, ranges), start=1):
             name = str(p.get("name", f"position {k}"))
             up = p.get("up")

@@ -355,7 +355,7 @@ def c_header(name: str, matrix: np.ndarray, bias: np.ndarray, bias_unit: str, co
         f"#ifndef {guard}",
         f"#define {guard}",
         "",
-        f"/* alignment matrix A = M^-1, dimensionless: w = A (g - b) */",
+        "/* alignment matrix A = M^-1, dimensionless: w = A (g - b) */",
         f"static const float {name}_A[3][3] = {{\n{rows}\n}};",
         "",
         f"/* gyro bias b in {bias_unit} */",

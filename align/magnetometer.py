@@ -20,7 +20,7 @@ MagCalibration, calibrate_magnetometer, alignment_to_gravity, misalignment_from_
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 

@@ -14,23 +14,16 @@ from __future__ import annotations
 
 import argparse
 import json
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _measure import measure  # noqa: E402
 
-LAUNCHER = (
-    "import resource, subprocess, sys, time\n"
-    "t0 = time.perf_counter()\n"
-    "p = subprocess.run(sys.argv[1:], capture_output=True, text=True)\n"
-    "wall = time.perf_counter() - t0\n"
-    "sys.stderr.write(p.stderr)\n"
-    "print(p.returncode, wall, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)\n"
-)
+ROOT = Path(__file__).resolve().parents[1]
 
 ANCHOR = """
 import json, sys
@@ -43,14 +36,6 @@ for j in range(data.shape[1]):
     out[j] = ad.tolist()
 json.dump(out, open(sys.argv[3], "w"))
 """
-
-
-def run(cmd: list[str]) -> tuple[float, float]:
-    out = subprocess.run([sys.executable, "-c", LAUNCHER, *cmd], capture_output=True, text=True)
-    code, wall, rss = out.stdout.split()
-    if code != "0":
-        raise SystemExit(f"failed: {' '.join(cmd)}\n{out.stderr}")
-    return float(wall), float(rss) / 1024
 
 
 def main() -> None:
@@ -70,12 +55,11 @@ def main() -> None:
     names = ",".join(f"c{j}" for j in range(args.channels))
     ours_cmd = [sys.executable, "-m", "align.cli", "allan", str(npy), "--rate-hz", "2000", "--columns", names,
                 "--json", str(ours_json)]
-    run(ours_cmd)  # first run compiles and caches the numba kernels (reported separately)
-    t_cold = None
-    t_ours, m_ours = run(ours_cmd)
+    measure(ours_cmd)  # first run compiles and caches the numba kernels (reported separately)
+    t_ours, m_ours = measure(ours_cmd)
     anchor = folder / "anchor.py"
     anchor.write_text(ANCHOR)
-    t_at, m_at = run([sys.executable, str(anchor), str(npy), str(ours_json), str(theirs_json)])
+    t_at, m_at = measure([sys.executable, str(anchor), str(npy), str(ours_json), str(theirs_json)])
     ours = json.loads(ours_json.read_text())
     theirs = json.loads(theirs_json.read_text())
     worst = max(np.max(np.abs(np.array(theirs[str(j)]) / np.array(ours["adev"][f"c{j}"]) - 1)) for j in range(args.channels))

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import argparse
 import resource
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -27,6 +26,9 @@ sys.path.insert(0, str(ROOT))
 from align.fileio import read_toml  # noqa: E402
 from mechanics.budget import monte_carlo  # noqa: E402
 from mechanics.mount import mount_from_dict  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _measure import measure  # noqa: E402
 
 MOUNT = ROOT / "examples" / "budget" / "example1.toml"
 
@@ -54,14 +56,10 @@ def main() -> None:
     t_mc = time.perf_counter() - t0
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     t_naive = naive_2d(args.draws, 1)
-    launcher = ("import resource, subprocess, sys, time\n"
-                "t0 = time.perf_counter(); p = subprocess.run(sys.argv[1:], capture_output=True)\n"
-                "print(p.returncode, time.perf_counter() - t0, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)\n")
-    out = subprocess.run([sys.executable, "-c", launcher, sys.executable, "-m", "align.cli", "budget", str(MOUNT),
-                          "--monte-carlo", str(args.draws)], capture_output=True, text=True).stdout.split()
+    wall, rss = measure([sys.executable, "-m", "align.cli", "budget", str(MOUNT), "--monte-carlo", str(args.draws)])
     print(f"Monte Carlo, {args.draws:,} draws of the 3-D model: {t_mc:.3f} s in-process, "
           f"peak RSS {peak:.0f} MB (before: {before / 1024:.0f} MB); p99.73 any axis {np.degrees(mc.percentiles['99.73'][3]):.4f} deg")
-    print(f"whole `imu-align budget --monte-carlo {args.draws}` process: {float(out[1]):.3f} s, peak RSS {int(out[2]) / 1024:.0f} MB (exit {out[0]})")
+    print(f"whole `imu-align budget --monte-carlo {args.draws}` process: {wall:.3f} s, peak RSS {rss:.0f} MB")
     print(f"naive 2-D RSS draw of the source terms (reference for scale): {t_naive:.3f} s; ratio 3-D / naive {t_mc / t_naive:.1f}")
     print("target: under 1 s and under 500 MB")
 

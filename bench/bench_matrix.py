@@ -12,7 +12,6 @@ Target (issue 2): the whole run within 2x the pandas read and under 3 s.
 from __future__ import annotations
 
 import argparse
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -28,6 +27,9 @@ from align.plan import Plan, Step  # noqa: E402
 from align.simulate import SessionSpec, simulate_session  # noqa: E402
 from align.units import DEG, to_unit  # noqa: E402
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _measure import measure  # noqa: E402
+
 
 def make_session(folder: Path) -> tuple[Path, Path, int]:
     steps = tuple(Step(a, 1, rate=s * r * DEG) for a in range(3) for r in (50, 100, 200) for s in (1, -1))
@@ -41,32 +43,6 @@ def make_session(folder: Path) -> tuple[Path, Path, int]:
     return log, plan_path, len(t)
 
 
-_LAUNCHER = (
-    "import resource, subprocess, sys, time\n"
-    "t0 = time.perf_counter()\n"
-    "p = subprocess.run(sys.argv[1:], capture_output=True, text=True)\n"
-    "wall = time.perf_counter() - t0\n"
-    "sys.stderr.write(p.stderr)\n"
-    "print(p.returncode, wall, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)\n"
-)
-
-
-def measured(cmd: list[str], repeat: int) -> tuple[float, float]:
-    """Best wall time (s) over ``repeat`` runs and the peak RSS (MB) of that command alone.
-
-    Each run goes through a small launcher process, so the launcher's
-    RUSAGE_CHILDREN describes this command and nothing else.
-    """
-    best, peak = float("inf"), 0.0
-    for _ in range(repeat):
-        out = subprocess.run([sys.executable, "-c", _LAUNCHER, *cmd], capture_output=True, text=True)
-        code, wall, rss_kb = out.stdout.split()
-        if code != "0":
-            raise SystemExit(f"failed: {' '.join(cmd)}\n{out.stderr}")
-        best, peak = min(best, float(wall)), max(peak, float(rss_kb) / 1024.0)
-    return best, peak
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
@@ -78,8 +54,8 @@ def main() -> None:
     size = log.stat().st_size / 1e6
     pandas_cmd = [sys.executable, "-c", f"import pandas as pd; df = pd.read_csv({str(log)!r}); print(len(df))"]
     ours_cmd = [sys.executable, "-m", "align.cli", "matrix", str(log), "--plan", str(plan), "--json", str(folder / "r.json")]
-    t_pd, m_pd = measured(pandas_cmd, args.repeat)
-    t_us, m_us = measured(ours_cmd, args.repeat)
+    t_pd, m_pd = measure(pandas_cmd, args.repeat)
+    t_us, m_us = measure(ours_cmd, args.repeat)
     print(f"session: {rows} rows, {size:.1f} MB CSV ({log})")
     print(f"pandas.read_csv alone (whole process): {t_pd:6.3f} s   peak RSS {m_pd:7.1f} MB")
     print(f"imu-align matrix      (whole process): {t_us:6.3f} s   peak RSS {m_us:7.1f} MB")

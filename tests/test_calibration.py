@@ -6,12 +6,11 @@ import json
 import numpy as np
 import pandas as pd
 import pytest
-from scipy.spatial.transform import Rotation
 
 from align.calibration import Calibration, calibrate_accel, ferraris
-from align.errors import AlignError, InputError, TestError
+from align.errors import InputError, TestError
 from align.magnetometer import calibrate_magnetometer
-from align.units import DEG, parse_unit
+from align.units import DEG
 
 from conftest import SHARED
 from magsim import F, capture, truth
@@ -50,7 +49,7 @@ def test_ferraris_session_against_imucal():
 
 
 def test_imucal_reads_our_file_and_corrects_like_apply(tmp_path, run_cli):
-    imucal = pytest.importorskip("imucal")
+    pytest.importorskip("imucal")
     from imucal.management import load_calibration_info
 
     out, imu_json = tmp_path / "cal.json", tmp_path / "imucal.json"

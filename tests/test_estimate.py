@@ -5,7 +5,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from align.alignment import AlignOptions, align
-from align.estimate import Observation, fit_lsq, fit_rate_pairs, two_axis, two_axis_error_bound
+from align.estimate import Observation, fit_rate_pairs, two_axis_error_bound
 from align.model import SensorModel
 from align.plan import Plan, Step
 from align.segment import Segment

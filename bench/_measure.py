@@ -1,0 +1,30 @@
+"""Measure a whole process: wall time and its own peak RSS (through a small launcher process)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+_LAUNCHER = (
+    "import resource, subprocess, sys, time\n"
+    "t0 = time.perf_counter()\n"
+    "p = subprocess.run(sys.argv[1:], capture_output=True, text=True)\n"
+    "wall = time.perf_counter() - t0\n"
+    "sys.stderr.write(p.stderr)\n"
+    "print(p.returncode, wall, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)\n"
+)
+
+
+def measure(cmd: list[str], repeat: int = 1) -> tuple[float, float]:
+    """Best wall time (s) over ``repeat`` runs and the peak RSS (MB) of ``cmd`` alone.
+
+    The launcher's RUSAGE_CHILDREN describes this command and nothing else.
+    """
+    best, peak = float("inf"), 0.0
+    for _ in range(repeat):
+        out = subprocess.run([sys.executable, "-c", _LAUNCHER, *cmd], capture_output=True, text=True)
+        code, wall, rss_kb = out.stdout.split()
+        if code != "0":
+            raise SystemExit(f"failed: {' '.join(cmd)}\n{out.stderr}")
+        best, peak = min(best, float(wall)), max(peak, float(rss_kb) / 1024.0)
+    return best, peak
