@@ -89,7 +89,7 @@ class ArrayChunks:
             yield np.asarray(self.data[start : start + rows, cols], dtype=np.float64)
 
 
-def _phases(source, fs: float, memory_limit: float, names) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _phases(source, fs: float, memory_limit: float, names, progress=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Phases ``[0, cumsum(y - c) / fs]`` of every column in one pass, shape (C, n + 1).
 
     ``c`` is the mean of the first chunk (the whole column when it fits one
@@ -127,6 +127,8 @@ def _phases(source, fs: float, memory_limit: float, names) -> tuple[np.ndarray, 
             np.cumsum(seg, out=seg)
             carry[j] = seg[-1]
         pos += k
+        if progress is not None:
+            progress(pos - 1)
     x[:, 1:] *= 1.0 / fs
     return x, const, const + total / n
 
@@ -249,7 +251,7 @@ def allan(data, fs: float, names=None, grid="dense", per_decade: int = 10, modif
     memory_limit : float
         Bytes of phase kept in memory; a larger phase goes to a temporary file.
     progress : callable, optional
-        Called with the number of channels done (once, at the end).
+        Called with the number of samples read so far.
     periods : sequence of float
         Averaging periods (s) of the bias stability.
 
@@ -264,7 +266,7 @@ def allan(data, fs: float, names=None, grid="dense", per_decade: int = 10, modif
     m = tau_grid(n, fs, grid, per_decade)
     avar_sums, mvar_sums = _get_kernels()
     tau = m / fs
-    x, _, means = _phases(source, fs, memory_limit, names)
+    x, _, means = _phases(source, fs, memory_limit, names, progress)
     adev = np.sqrt(avar_sums(x, m) / (2.0 * tau**2 * (n + 1 - 2 * m)))
     mdev = None
     if modified:
@@ -273,6 +275,4 @@ def allan(data, fs: float, names=None, grid="dense", per_decade: int = 10, modif
         mdev[:, : len(mm)] = np.sqrt(mvar_sums(x, mm) / (2.0 * mm.astype(float) ** 2 * (mm / fs) ** 2 * (n + 1 - 3 * mm + 1)))
     stability = {p: np.array([window_stability(x[j], fs, p) for j in range(c)]) for p in periods}
     del x
-    if progress is not None:
-        progress(c)
     return AllanResult(tau, m, adev, mdev, n, fs, names, means, stability)

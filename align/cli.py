@@ -342,7 +342,7 @@ def check(
 
 @app.command()
 def allan(
-    logs: list[Path] = typer.Argument(..., help="Static recordings: .csv, .csv.gz or .npy; several runs give the bias repeatability."),
+    logs: list[Path] = typer.Argument(..., help="Static recordings: .csv, .csv.gz, .npy or raw float64 .bin; several runs give the bias repeatability."),
     columns: str = typer.Option("gyro_x,gyro_y,gyro_z", help="Data columns (a CSV's time column is 'time' unless --rate-hz)."),
     rate_hz: Optional[float] = typer.Option(None, help="Sample rate for files without a time column (.npy always)."),
     gyro_units: str = typer.Option("deg/s", help="Unit of the data columns (an angular rate)."),
@@ -355,6 +355,7 @@ def allan(
     rate: Optional[str] = typer.Option(None, help="Table rate, to plan: draws the target and the averaging time."),
     accuracy: Optional[str] = typer.Option(None, help="Alignment goal, to plan (with --rate)."),
     noise_ratio: float = typer.Option(10.0, help="Noise this many times below the goal, to plan."),
+    memory_limit_mb: float = typer.Option(2000.0, help="Phase kept in memory up to this size; beyond it, a temporary file."),
 ) -> None:
     """Allan deviation, noise-model fit and noise figures of static recordings."""
 
@@ -378,8 +379,10 @@ def allan(
             raise InputError(f"sample rate {f:g} Hz differs from the first run's {fs:g} Hz", str(log))
         runs.append(data)
         fs = f
-    with _progress(len(names), "Allan deviation") as tick:
-        job = run_allan(runs, fs, names, unit, grid_value, per_decade, modified, progress=tick)
+    rows = runs[0].shape[0]
+    with _progress(rows, "Allan deviation (samples read)") as tick:
+        job = run_allan(runs, fs, names, unit, grid_value, per_decade, modified, progress=tick,
+                        memory_limit=memory_limit_mb * 1e6)
     job = type(job)(**{**job.__dict__, "inputs": [str(p) for p in logs]})
     d = job.to_dict()
     target = chosen = None
@@ -425,10 +428,10 @@ def _static_log(log: Path, names: list[str], rate_hz: Optional[float]):
     from . import fileio
     from .errors import InputError
 
-    if log.suffix.lower() == ".npy":
+    if log.suffix.lower() in (".npy", ".bin", ".f8", ".f4", ".raw"):
         if rate_hz is None:
-            raise InputError("a .npy file has no time: give --rate-hz", str(log))
-        source = fileio.NpyChunks(log)
+            raise InputError(f"a {log.suffix} file has no time: give --rate-hz", str(log))
+        source = fileio.NpyChunks(log, len(names))
         if source.shape[1] != len(names):
             raise InputError(f"array of shape {source.shape} has {source.shape[1]} columns; name them all with --columns",
                              str(log))

@@ -215,7 +215,10 @@ def read_log(
 
 
 class NpyChunks:
-    """Row chunks of a 2-D .npy file read with ``numpy.fromfile``: no memory map, bounded memory.
+    """Row chunks of a 2-D .npy file (or raw binary) read with ``numpy.fromfile``: bounded memory.
+
+    Raw binary files (``.bin``/``.f8``: little-endian float64, ``.f4``: float32)
+    hold ``channels`` interleaved columns and no header.
 
     Attributes
     ----------
@@ -223,8 +226,18 @@ class NpyChunks:
         ``(n, C)`` of the stored array.
     """
 
-    def __init__(self, path: str | Path) -> None:
+    def __init__(self, path: str | Path, channels: int | None = None) -> None:
         p = _exists(path)
+        if p.suffix.lower() in (".bin", ".f8", ".f4", ".raw"):
+            dtype = np.dtype("<f4" if p.suffix.lower() == ".f4" else "<f8")
+            if not channels:
+                raise InputError("a raw binary file needs its number of columns (--columns)", str(path))
+            size = p.stat().st_size
+            if size % (dtype.itemsize * channels):
+                raise InputError(f"{size} bytes is not a whole number of {channels}-column {dtype} rows", str(path))
+            self.path, self.offset, self.fortran, self.dtype = p, 0, False, dtype
+            self.shape = (size // (dtype.itemsize * channels), channels)
+            return
         try:
             with open(p, "rb") as fh:
                 version = np.lib.format.read_magic(fh)

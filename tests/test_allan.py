@@ -144,6 +144,9 @@ def test_npy_chunks_give_the_same_result(tmp_path):
     a = allan(y, 50.0)
     b = allan(NpyChunks(tmp_path / "y.npy"), 50.0)
     assert np.allclose(a.adev, b.adev, rtol=1e-12, atol=0)
+    y.astype("<f8").tofile(tmp_path / "y.bin")  # raw binary, two interleaved columns
+    c = allan(NpyChunks(tmp_path / "y.bin", 2), 50.0, memory_limit=1e3)
+    assert np.allclose(a.adev, c.adev, rtol=1e-12, atol=0)
 
 
 def test_allan_cli_on_real_adis16405_and_plan_from_it(tmp_path, run_cli):
