@@ -276,7 +276,7 @@ def align(
     elif method == "angle":
         fit = fit_angle_pairs(used, plan)
     else:
-        fit = fit_lsq(used, plan.rate_accuracy, method)
+        fit = fit_lsq(used, _table_accuracy(plan), method)
     notes = []
     m, sigma_m = fit.M, fit.sigma_M
     if method == "two-axis":
@@ -299,8 +299,6 @@ def align(
             cov[i, :, missing] = 0.0
             cov[i, missing, missing] = sigma_m[i, missing] ** 2
     sigma_a = alignment_sigma(m, cov)
-    if plan.angle_accuracy and plan.kind == "angle":
-        sigma_m = np.hypot(sigma_m, np.abs(m) * plan.angle_accuracy / min(abs(s.angle) for s in plan.steps))
     noise = np.sqrt(np.array([o.var for o in used]))
     checks.append(check_residuals([o.segment for o in used], np.abs(fit.residuals).max(axis=1), noise.max(axis=1), units))
     notes.append(_earth_note(plan, earth, m))
@@ -314,6 +312,13 @@ def align(
         sigma_bias=fit.sigma_bias, condition_number=fit.condition_number, dof=fit.dof, segments=reports,
         checks=tuple(checks), notes=tuple(notes), units=units, inferred_axis=missing,
     )
+
+
+def _table_accuracy(plan: Plan) -> float:
+    """Relative accuracy of the table: its rate accuracy, or its angle accuracy over the smallest turn."""
+    if plan.kind == "angle" and plan.angle_accuracy:
+        return plan.angle_accuracy / min(abs(s.angle) for s in plan.steps)
+    return plan.rate_accuracy
 
 
 def _earth_note(plan: Plan, corrected: bool, m: np.ndarray) -> str:

@@ -157,7 +157,7 @@ def fit_lsq(obs: list[Observation], rate_accuracy: float = 0.0, method: str = "l
     ``sum_k (y_ki - phi_k . x_i)^2 / var_ki``. The covariance is
     ``(Phi^T W Phi)^-1``, inflated by ``chi2 / dof`` when that exceeds 1 (the
     scatter between segments is larger than the noise inside them, e.g. bias
-    drift); a stated table rate accuracy adds ``(M_ij rate_accuracy)^2``.
+    drift); a stated relative table accuracy (rate, or angle over the turn) adds ``(M_ij rate_accuracy)^2``.
 
     Columns of ``M`` for axes never turned about are left NaN (the two-axis
     shortcut fills them). With ``equal_weights`` it is ordinary least squares,
