@@ -374,7 +374,7 @@ def allan(
     grid_value = grid if grid in ("dense", "octave", "decade") else _taus(grid)
     runs, fs = [], None
     for log in logs:
-        data, f = _static_log(log, names, rate_hz)
+        data, f = fileio.read_static(log, names, rate_hz)
         if fs is not None and abs(f - fs) > 1e-9 * fs:
             raise InputError(f"sample rate {f:g} Hz differs from the first run's {fs:g} Hz", str(log))
         runs.append(data)
@@ -419,38 +419,6 @@ def _taus(text: str) -> list[float]:
     if not taus or min(taus) <= 0:
         raise InputError("taus must be positive seconds", "--grid")
     return taus
-
-
-def _static_log(log: Path, names: list[str], rate_hz: Optional[float]):
-    """Raw columns of a static log (no unit conversion: the Allan deviation is scaled afterwards) and its rate."""
-    import numpy as np
-
-    from . import fileio
-    from .errors import InputError
-
-    if log.suffix.lower() in (".npy", ".bin", ".f8", ".f4", ".raw"):
-        if rate_hz is None:
-            raise InputError(f"a {log.suffix} file has no time: give --rate-hz", str(log))
-        source = fileio.NpyChunks(log, len(names))
-        if source.shape[1] != len(names):
-            raise InputError(f"array of shape {source.shape} has {source.shape[1]} columns; name them all with --columns",
-                             str(log))
-        return source, float(rate_hz)
-    wanted = names if rate_hz is not None else ["time"] + names
-    got, data = fileio.read_columns(log, wanted)
-    if rate_hz is not None:
-        return data, float(rate_hz)
-    t = data[:, 0]
-    dt = np.diff(t)
-    if len(dt) < 2 or np.any(~np.isfinite(dt)) or np.any(dt <= 0):
-        raise InputError("time column is not increasing (or too short)", str(log))
-    med = float(np.median(dt))
-    gaps = np.flatnonzero(np.abs(dt - med) > 0.5 * med)
-    if len(gaps):
-        k = int(gaps[0])
-        raise InputError(f"{len(gaps)} time gaps or jitter over 50 % of the {med:.4g} s step (first at t={t[k]:.6g} s, "
-                         f"step {dt[k]:.4g} s); an Allan deviation needs uniform samples: resample or split the file", str(log))
-    return np.ascontiguousarray(data[:, 1:]), 1.0 / med
 
 
 @app.command()

@@ -8,7 +8,7 @@ never leaves a half-written output.
 
 Public names
 ------------
-read_columns, read_log, NpyChunks, read_toml, read_json, write_json, write_text, write_bytes,
+read_columns, read_log, read_static, NpyChunks, read_toml, read_json, write_json, write_text, write_bytes,
 write_csv, c_header
 """
 
@@ -271,6 +271,40 @@ class NpyChunks:
                         block = block[:, cols]
                     block = block.astype(np.float64, copy=False)
                 yield block
+
+
+def read_static(log: str | Path, names: list[str], rate_hz: float | None):
+    """Raw columns of a static log and its sample rate, for the Allan deviation.
+
+    No unit conversion (the deviations are scaled afterwards, so no SI copy of a
+    large record is made). ``.npy`` and raw binary files come back as a
+    :class:`NpyChunks` source read in chunks; CSV needs a uniform time column
+    (gaps are refused with their position) unless ``rate_hz`` is given.
+    """
+    log = Path(log)
+    if log.suffix.lower() in (".npy", ".bin", ".f8", ".f4", ".raw"):
+        if rate_hz is None:
+            raise InputError(f"a {log.suffix} file has no time: give --rate-hz", str(log))
+        source = NpyChunks(log, len(names))
+        if source.shape[1] != len(names):
+            raise InputError(f"array of shape {source.shape} has {source.shape[1]} columns; name them all with --columns",
+                             str(log))
+        return source, float(rate_hz)
+    wanted = names if rate_hz is not None else ["time"] + names
+    _, data = read_columns(log, wanted)
+    if rate_hz is not None:
+        return data, float(rate_hz)
+    t = data[:, 0]
+    dt = np.diff(t)
+    if len(dt) < 2 or np.any(~np.isfinite(dt)) or np.any(dt <= 0):
+        raise InputError("time column is not increasing (or too short)", str(log))
+    med = float(np.median(dt))
+    gaps = np.flatnonzero(np.abs(dt - med) > 0.5 * med)
+    if len(gaps):
+        k = int(gaps[0])
+        raise InputError(f"{len(gaps)} time gaps or jitter over 50 % of the {med:.4g} s step (first at t={t[k]:.6g} s, "
+                         f"step {dt[k]:.4g} s); an Allan deviation needs uniform samples: resample or split the file", str(log))
+    return np.ascontiguousarray(data[:, 1:]), 1.0 / med
 
 
 def read_toml(path: str | Path) -> dict:

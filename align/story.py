@@ -95,12 +95,11 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
              f"{'PASSES' if results['check']['pass'] else 'FAILS'} the check"]
     plan_dict = allan_dict = plot = None
     if allan is not None:
-        from .cli import _static_log
         from .noisereport import allan_plot_png, run_allan
         from .planner import make_plan
 
         names = [c.strip() for c in allan_columns.split(",")]
-        data, fs = _static_log(Path(allan), names, allan_rate_hz)
+        data, fs = fileio.read_static(allan, names, allan_rate_hz)
         job = run_allan([data], fs, names, allan_units)
         job = type(job)(**{**job.__dict__, "inputs": [str(allan)]})
         allan_dict = job.to_dict()
