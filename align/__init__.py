@@ -22,6 +22,16 @@ checks     checks that turn a bad test into a clear error
 earth      Earth rotation rate
 simulate   rate-table session simulator
 alignment  the end-to-end alignment job and its result type
+sensitivity  what misalignment does to a manoeuvre; allowable misalignment (sympy)
+parts      datasheet presets shared by the budget and the planner
+allan      overlapping / modified Allan deviation (numba kernels in _allan_kernels)
+noisefit   five-term noise fit, IEEE readouts, the seed's noise figures
+noisesim   sensor-error simulator and the seed's error models
+planner    averaging time and test plan (Example 3)
+noisereport  the Allan job, its JSON form and plot
+calibration  accelerometer and gyro calibration (multi-position, Ferraris)
+magnetometer hard/soft-iron ellipsoid fit with gates
+summary    readable text summaries; report: the HTML report; story: demo and report job
 cli        the ``imu-align`` command line (a thin layer)
 """
 

@@ -55,7 +55,7 @@ def test_apply_corrects_log_to_true_rates(tmp_path, run_cli):
     assert run_cli("matrix", log, "--plan", plan, "--json", out).code == 0
     # a fresh noiseless log of known true rate
     t, g, w = simulate_session(RATE_PLAN, model, SessionSpec(noise_density=0.0), 1)
-    log2, _ = write_session(tmp_path / "..", t, g, RATE_PLAN) if False else write_session(tmp_path, t, g, RATE_PLAN)
+    log2, _ = write_session(tmp_path, t, g, RATE_PLAN)
     corrected = tmp_path / "corrected.csv"
     res = run_cli("apply", log2, "--alignment", out, "--out", corrected)
     assert res.code == 0, res.err
