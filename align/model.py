@@ -202,6 +202,21 @@ class SensorModel:
         return cls(m, bias)
 
     @classmethod
+    def from_angles(cls, psi, phi, bias=(0.0, 0.0, 0.0)) -> "SensorModel":
+        """Eq 5-10: ``M_ii = cos(psi_i)``, ``M_ij = sin(phi_ij)``.
+
+        Parameters
+        ----------
+        psi : array_like, shape (3,)
+            Axis-to-frame angles, rad.
+        phi : array_like, shape (3, 3)
+            Cross-axis angles ``phi_ij`` (rad); the diagonal is ignored.
+        """
+        m = np.sin(np.nan_to_num(np.asarray(phi, dtype=float)))
+        np.fill_diagonal(m, np.cos(np.asarray(psi, dtype=float)))
+        return cls(m, bias)
+
+    @classmethod
     def from_small_angles(cls, alpha: float, beta: float, gamma: float, bias=(0.0, 0.0, 0.0)) -> "SensorModel":
         """First-order model of a package rotated by ``alpha, beta, gamma`` (rad)."""
         return cls(small_rotation_matrix(alpha, beta, gamma), bias)

@@ -172,3 +172,12 @@ def test_apply_accel_and_mag_round_trip(tmp_path, run_cli):
 
     again = MagCalibration.from_dict(json.loads(json.dumps(c.to_dict())))
     assert np.allclose(again.correct(m), cal, rtol=1e-12)
+
+
+def test_ferraris_turn_in_the_wrong_direction_is_an_error(tmp_path, run_cli):
+    # imucal returns a matrix with -1 on the diagonal here, silently (anchors.md)
+    res = run_cli("calibrate", "ferraris", FERRARIS / "example_ferraris_session.csv", "--sections",
+                  FERRARIS / "example_ferraris_session_list.json", "--rate-hz", "102.4", "--turn-angle", "360 deg",
+                  "--json", tmp_path / "never.json")
+    assert res.code == 3 and "wrong way" in res.err and "x_rot" in res.err
+    assert not (tmp_path / "never.json").exists()

@@ -74,3 +74,17 @@ def test_rotation_vector_matches_scipy():
     for rv in list(rng.normal(size=(20, 3))) + [np.array([np.pi - 1e-3, 0, 0]), np.zeros(3), np.array([0, 0, 1e-9])]:
         r = Rotation.from_rotvec(rv).as_matrix()
         assert np.allclose(rotation_vector(r), Rotation.from_matrix(r).as_rotvec(), atol=1e-9)
+
+
+def test_from_angles_matches_the_sympy_form():
+    from align.sensitivity import ELEMENTS, matrix_from_angles
+
+    rng = np.random.default_rng(4)
+    vals = dict(zip(ELEMENTS, rng.normal(0, 0.05, 9)))
+    psi = [vals["psi_x"], vals["psi_y"], vals["psi_z"]]
+    phi = np.full((3, 3), np.nan)
+    for i, a in enumerate("xyz"):
+        for j, b in enumerate("xyz"):
+            if i != j:
+                phi[i, j] = vals[f"phi_{a}{b}"]
+    assert np.allclose(SensorModel.from_angles(psi, phi).M, matrix_from_angles(vals), atol=1e-15)
