@@ -233,7 +233,7 @@ class AllanResult:
 
 
 def allan(data, fs: float, names=None, grid="dense", per_decade: int = 10, modified: bool = False,
-          memory_limit: float = 2e9, progress=None, periods=(1.0, 10.0)) -> AllanResult:
+          memory_limit: float = 2e9, progress=None, periods=(1.0, 10.0), deviations: bool = True) -> AllanResult:
     """Overlapping (and optionally modified) Allan deviation of each column, and the seed's figures.
 
     Parameters
@@ -254,6 +254,8 @@ def allan(data, fs: float, names=None, grid="dense", per_decade: int = 10, modif
         Called with the number of samples read so far.
     periods : sequence of float
         Averaging periods (s) of the bias stability.
+    deviations : bool
+        False skips the deviations (left NaN) when only the bias figures are wanted.
 
     Raises
     ------
@@ -267,9 +269,9 @@ def allan(data, fs: float, names=None, grid="dense", per_decade: int = 10, modif
     avar_sums, mvar_sums = _get_kernels()
     tau = m / fs
     x, _, means = _phases(source, fs, memory_limit, names, progress)
-    adev = np.sqrt(avar_sums(x, m) / (2.0 * tau**2 * (n + 1 - 2 * m)))
+    adev = np.sqrt(avar_sums(x, m) / (2.0 * tau**2 * (n + 1 - 2 * m))) if deviations else np.full((c, len(m)), np.nan)
     mdev = None
-    if modified:
+    if modified and deviations:
         mdev = np.full((c, len(m)), np.nan)
         mm = m[3 * m <= n + 1]
         mdev[:, : len(mm)] = np.sqrt(mvar_sums(x, mm) / (2.0 * mm.astype(float) ** 2 * (mm / fs) ** 2 * (n + 1 - 3 * mm + 1)))

@@ -17,7 +17,7 @@ by ``true = M^-1 (raw - bias)``. The gyro may also carry a g-sensitivity
 
 Public names
 ------------
-Calibration, calibrate_accel, calibrate_accel_free, ferraris, FACES, imucal_dict
+Calibration, static_means, accel_session, calibrate_accel, calibrate_accel_free, ferraris, FACES, imucal_dict
 """
 
 from __future__ import annotations
@@ -97,6 +97,80 @@ class Calibration:
 def _obs(name: str, mean: np.ndarray, var: np.ndarray, phi: np.ndarray) -> Observation:
     return Observation(Segment(name, "static", 0, 1), np.asarray(mean, float), np.asarray(phi, float),
                        np.asarray(var, float), 1.0)
+
+
+def static_means(x: np.ndarray, ranges: dict, max_spread: float, where: str = "") -> dict:
+    """Mean reading of each named sample range ``(start, end)``, refusing ranges that are not static.
+
+    A range is static when every axis varies by at most ``max_spread`` times the
+    median magnitude of the readings (1 sigma): unit-free, so raw counts work too.
+    """
+    limit = max_spread * float(np.median(np.linalg.norm(x, axis=1)))
+    out = {}
+    for name, (a, b) in ranges.items():
+        if not 0 <= a < b <= len(x):
+            raise InputError(f"samples {a}..{b} are outside the log's {len(x)} samples", f"{where}{name}")
+        if b - a < 10:
+            raise TestError(f"only {b - a} samples: too short for a static position", name)
+        spread = float(np.std(x[a:b], axis=0).max())
+        if spread > limit:
+            raise TestError(f"not static: the readings vary by {spread:.3g} (1 sigma) over samples {a}..{b}; "
+                            "check the range", name)
+        out[name] = x[a:b].mean(axis=0)
+    return out
+
+
+def accel_session(t: np.ndarray, a: np.ndarray, intervals: list, positions: list | None, gravity: float,
+                  units: str, where: str = "log", positions_file: str = "positions") -> Calibration:
+    """An accelerometer session: known positions (``[[position]]`` tables) or, without them, ``|a| = g``.
+
+    Parameters
+    ----------
+    t, a : ndarray
+        Time (s) and readings (n, 3), SI or counts.
+    intervals : list of (start, end)
+        Static intervals found by :func:`align.segment.static_intervals`, used
+        when the positions give no ``start``/``end`` (matched in order) and for the free fit.
+    positions : list of dict or None
+        Each with ``up`` (``"+x"`` or ``[x, y, z]``), optional ``name``, ``start``, ``end``, ``holdout``.
+    """
+    from .plan import parse_axis
+
+    if positions is None:
+        means = static_means(a, {f"interval {k + 1}": r for k, r in enumerate(intervals)}, 0.02, f"{where}: ")
+        cal = calibrate_accel_free(np.array(list(means.values())), gravity, units)
+        note = f"{len(intervals)} static intervals detected automatically (moving variance)"
+        return Calibration(**{**cal.__dict__, "notes": cal.notes + (note,)})
+    if not isinstance(positions, list) or not positions:
+        raise InputError("no [[position]] tables", positions_file)
+    if all("start" in p for p in positions):
+        ranges = [(int(p["start"]), int(p["end"])) for p in positions]
+    elif any("start" in p for p in positions):
+        raise InputError("give start/end for every position or for none (automatic detection)", positions_file)
+    else:
+        if len(intervals) != len(positions):
+            found = "; ".join(f"t={t[s]:.1f}-{t[e - 1]:.1f} s" for s, e in intervals[:20])
+            raise TestError(f"{len(intervals)} static intervals detected but {len(positions)} positions listed ({found}); "
+                            "adjust --factor/--window or give start/end per position", where)
+        ranges = intervals
+    names, ups, hold = [], {}, []
+    for k, p in enumerate(positions, start=1):
+        name = str(p.get("name", f"position {k}"))
+        up = p.get("up")
+        if isinstance(up, str):
+            axis, sign = parse_axis(up, f"{positions_file}: {name}.up")
+            u = np.zeros(3)
+            u[axis] = sign
+        elif isinstance(up, list) and len(up) == 3:
+            u = np.asarray(up, float) / np.linalg.norm(up)
+        else:
+            raise InputError("up must be an axis ('+x') or a vector [x, y, z]", f"{positions_file}: {name}.up")
+        names.append(name)
+        ups[name] = u
+        if p.get("holdout"):
+            hold.append(name)
+    means = static_means(a, dict(zip(names, ranges)), 0.02, f"{positions_file}: ")
+    return calibrate_accel(means, ups, gravity, units, tuple(hold))
 
 
 def calibrate_accel(means: dict, ups: dict, gravity: float = STANDARD_GRAVITY, units: str = "m/s^2",
@@ -222,17 +296,11 @@ def ferraris(acc: np.ndarray, gyr: np.ndarray, fs: float, sections: dict, turn_a
     missing = [k for k in need if k not in sections]
     if missing:
         raise InputError(f"missing sections {', '.join(missing)} (imucal's names: {', '.join(need)})", "sections")
-    n = len(acc)
     for name, (a, b) in sections.items():
-        if not 0 <= a < b <= n:
-            raise InputError(f"{a}..{b} is not inside the log's {n} samples", f"sections: {name}")
-        if name in FACES and b - a < 10:
-            raise TestError(f"only {b - a} samples: too short for a static face", name)
-    means = {f: acc[a:b].mean(axis=0) for f, (a, b) in sections.items() if f in FACES}
-    for f, (a, b) in ((f, sections[f]) for f in FACES):
-        spread = np.std(acc[a:b], axis=0).max()
-        if spread > 0.05 * gravity:
-            raise TestError(f"the accelerometer varies by {spread:.3g} m/s^2 (1 sigma): not static; check the section range", f)
+        if not 0 <= a < b <= len(acc):
+            raise InputError(f"{a}..{b} is not inside the log's {len(acc)} samples", f"sections: {name}")
+    means = static_means(acc, {f: sections[f] for f in FACES}, 0.05 * gravity / np.median(np.linalg.norm(acc, axis=1)))
+    n = len(acc)
     ups = {}
     for f, (axis, sign) in FACES.items():
         u = np.zeros(3)

@@ -620,9 +620,8 @@ def calibrate_accel_cmd(
     import numpy as np
 
     from . import fileio
-    from .calibration import calibrate_accel, calibrate_accel_free
-    from .errors import InputError, TestError
-    from .plan import parse_axis
+    from .calibration import accel_session
+    from .checks import check_log
     from .segment import static_intervals
     from .summary import calibration_summary
     from .units import parse_unit
@@ -631,56 +630,13 @@ def calibrate_accel_cmd(
     time_col, cols = _columns(columns, rate_hz)
     counts = parse_unit(units).dim == parse_unit("counts").dim
     t, a = fileio.read_log(log, cols, units, time_col, rate_hz, expect="counts" if counts else "acceleration")
+    check_log(t, a, str(log))
     fs = 1.0 / float(np.median(np.diff(t)))
     spec = fileio.read_toml(positions) if positions is not None else {}
     g = q(gravity or spec.get("gravity", "9.80665 m/s^2"), "acceleration", "--gravity" if gravity else f"{positions}: gravity")
-    bad = ~np.isfinite(a).all(axis=1)
-    if bad.any():
-        raise InputError(f"{int(bad.sum())} rows with NaN (first at data row {int(np.flatnonzero(bad)[0]) + 1})", str(log))
     intervals = static_intervals(a, fs, q(window, "time", "--window"), factor,
                                  q(init_static, "time", "--init-static") if init_static else None, q(min_static, "time", "--min-static"))
-    if positions is None:
-        means = np.array([a[s:e].mean(axis=0) for s, e in intervals])
-        cal = calibrate_accel_free(means, g, units)
-        note = f"{len(intervals)} static intervals detected automatically (moving variance, factor {factor:g})"
-        cal = type(cal)(**{**cal.__dict__, "notes": cal.notes + (note,)})
-    else:
-        items = spec.get("position")
-        if not isinstance(items, list) or not items:
-            raise InputError("no [[position]] tables", str(positions))
-        if all("start" in p for p in items):
-            ranges = [(int(p["start"]), int(p["end"])) for p in items]
-        elif any("start" in p for p in items):
-            raise InputError("give start/end for every position or for none (automatic detection)", str(positions))
-        else:
-            if len(intervals) != len(items):
-                found = "; ".join(f"t={t[s]:.1f}-{t[e - 1]:.1f} s" for s, e in intervals[:20])
-                raise TestError(f"{len(intervals)} static intervals detected but {len(items)} positions listed ({found}); "
-                                "adjust --factor/--window or give start/end per position", str(log))
-            ranges = intervals
-        means, ups, hold = {}, {}, []
-        for k, (p, (s, e)) in enumerate(zip(items, ranges), start=1):
-            name = str(p.get("name", f"position {k}"))
-            up = p.get("up")
-            if isinstance(up, str):
-                axis, sign = parse_axis(up, f"{positions}: {name}.up")
-                u = np.zeros(3)
-                u[axis] = sign
-            elif isinstance(up, list) and len(up) == 3:
-                u = np.asarray(up, float)
-                u = u / np.linalg.norm(u)
-            else:
-                raise InputError("up must be an axis ('+x') or a vector [x, y, z]", f"{positions}: {name}.up")
-            if not 0 <= s < e <= len(a):
-                raise InputError(f"samples {s}..{e} are outside the log", f"{positions}: {name}")
-            seg = a[s:e]
-            spread = float(np.std(seg, axis=0).max())
-            if spread > 0.02 * g * (1 if not counts else np.median(np.linalg.norm(a, axis=1)) / g):
-                raise TestError(f"not static: the readings vary by {spread:.3g} (1 sigma) over samples {s}..{e}", name)
-            means[name], ups[name] = seg.mean(axis=0), u
-            if p.get("holdout"):
-                hold.append(name)
-        cal = calibrate_accel(means, ups, g, units, tuple(hold))
+    cal = accel_session(t, a, intervals, spec.get("position"), g, units, str(log), str(positions))
     typer.echo(calibration_summary({"accelerometer": cal}))
     if json_out is not None:
         fileio.write_json(json_out, _calibration_file({"accelerometer": cal}, {"log": str(log),

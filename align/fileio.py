@@ -294,17 +294,12 @@ def read_static(log: str | Path, names: list[str], rate_hz: float | None):
     _, data = read_columns(log, wanted)
     if rate_hz is not None:
         return data, float(rate_hz)
+    from .checks import check_log, check_time
+
     t = data[:, 0]
-    dt = np.diff(t)
-    if len(dt) < 2 or np.any(~np.isfinite(dt)) or np.any(dt <= 0):
-        raise InputError("time column is not increasing (or too short)", str(log))
-    med = float(np.median(dt))
-    gaps = np.flatnonzero(np.abs(dt - med) > 0.5 * med)
-    if len(gaps):
-        k = int(gaps[0])
-        raise InputError(f"{len(gaps)} time gaps or jitter over 50 % of the {med:.4g} s step (first at t={t[k]:.6g} s, "
-                         f"step {dt[k]:.4g} s); an Allan deviation needs uniform samples: resample or split the file", str(log))
-    return np.ascontiguousarray(data[:, 1:]), 1.0 / med
+    check_log(t, data[:, 1:], str(log), min_rows=3)
+    check_time(t, str(log), gap=1.5, jitter=True)  # an Allan deviation needs uniform samples
+    return np.ascontiguousarray(data[:, 1:]), 1.0 / float(np.median(np.diff(t)))
 
 
 def read_toml(path: str | Path) -> dict:

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import __version__
+from .checks import check_finite
 from .errors import InputError, TestError
 from .units import DEG, to_unit
 
@@ -201,9 +202,7 @@ def calibrate_magnetometer(m: np.ndarray, units: str = "uT", field: float | None
     if model not in MODELS:
         raise InputError(f"unknown model '{model}'; choose {', '.join(MODELS)}", "--model")
     m = np.asarray(m, float)
-    bad = ~np.isfinite(m).all(axis=1)
-    if bad.any():
-        raise InputError(f"{int(bad.sum())} rows with NaN (first at data row {int(np.flatnonzero(bad)[0]) + 1})", "magnetometer")
+    check_finite(m, "magnetometer")
     n_par = {"sphere": 4, "diagonal": 6, "symmetric": 9}[model]
     if len(m) < 3 * n_par:
         raise InputError(f"only {len(m)} samples; the {model} model needs at least {3 * n_par}", "magnetometer")

@@ -98,15 +98,16 @@ def _term(value: float, k: int, units: str, tu) -> float | None:
 
 def run_allan(runs: list, fs: float, names: list[str], units: str, grid="dense", per_decade: int = 10,
               modified: bool = False, periods=(1.0, 10.0), progress=None, memory_limit: float = 2e9) -> AllanJob:
-    """Allan deviation and noise figures of every run, the fit of the first, the repeatability.
+    """Allan deviation and fit of the first run, noise figures of every run, the repeatability.
 
     ``runs`` are raw arrays (n, C) or chunk sources in ``units``; everything is
     computed on the raw numbers and scaled afterwards (deviations, means and
     stabilities are linear in the unit), so no SI copy of a large record is made.
     """
     factor = parse_unit(units).factor
+    # the deviations of the first run; of the others only the bias figures (no kernel pass)
     results = [allan(r, fs, names, grid, per_decade, modified, memory_limit, progress=progress if k == 0 else None,
-                     periods=periods).scaled(factor) for k, r in enumerate(runs)]
+                     periods=periods, deviations=k == 0).scaled(factor) for k, r in enumerate(runs)]
     res = results[0]
     fits = tuple(fit_noise(res, j) for j in range(len(names)))
     figures = tuple({"bias": float(np.mean([r.bias[j] for r in results])),

@@ -210,6 +210,7 @@ def _series(series: dict, limits: dict, where: str, base_dir) -> Manoeuvre:
     from pathlib import Path
 
     from . import fileio
+    from .checks import check_log, check_time
 
     if "file" not in series:
         raise InputError("missing file = \"rates.csv\"", f"{where}: series.file")
@@ -220,20 +221,9 @@ def _series(series: dict, limits: dict, where: str, base_dir) -> Manoeuvre:
     if len(cols) != 4:
         raise InputError("columns must name time and three rates", f"{where}: series.columns")
     t, w = fileio.read_log(path, cols[1:], str(series.get("units", "deg/s")), cols[0])
-    if len(t) < 2:
-        raise InputError("needs at least two samples", str(path))
-    bad = ~np.isfinite(w).all(axis=1) | ~np.isfinite(t)
-    if bad.any():
-        raise InputError(f"NaN at data row {int(np.flatnonzero(bad)[0]) + 1}", str(path))
-    dt = np.diff(t)
-    med = float(np.median(dt))
-    if np.any(dt <= 0):
-        raise InputError(f"time does not increase at data row {int(np.argmax(dt <= 0)) + 2}", str(path))
-    if np.any(dt > 1.5 * med):
-        k = int(np.argmax(dt > 1.5 * med))
-        raise InputError(f"gap in the time series at t={t[k]:.6g} s ({dt[k]:.3g} s, median step {med:.3g} s); "
-                         "resample or split the file", str(path))
-    inc = 0.5 * (w[1:] + w[:-1]) * dt[:, None]           # trapezoid increments
+    check_log(t, w, str(path), min_rows=2)
+    check_time(t, str(path), gap=1.5)
+    inc = 0.5 * (w[1:] + w[:-1]) * np.diff(t)[:, None]   # trapezoid increments
     return Manoeuvre(inc, limits, False, f"rate series {path.name}: {len(t)} samples, {t[-1] - t[0]:.4g} s")
 
 
