@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from .errors import HandednessError
+from align.errors import HandednessError
 
 AXES = ("x", "y", "z")
 

@@ -14,8 +14,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .errors import InputError
-from .units import parse_quantity
+from align.errors import InputError
+from align.units import parse_quantity
 
 
 @dataclass(frozen=True)

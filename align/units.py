@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 from functools import lru_cache
 
-from .errors import UnitError
+from align.errors import UnitError
 
 #: one degree in radians
 DEG = math.pi / 180.0

@@ -30,7 +30,7 @@ def truth_model(seed: int = 0, rot_deg: float = 0.6, scale_sd: float = 3e-3, del
 
 def write_session(folder: Path, t: np.ndarray, g: np.ndarray, plan, units: str = "deg/s") -> tuple[Path, Path]:
     """Write a simulated session as the CLI reads it."""
-    from align import fileio
+    from align.io import files as fileio
     from align.units import to_unit
 
     log, plan_path = folder / "session.csv", folder / "plan.toml"

@@ -5,11 +5,11 @@ import json
 import numpy as np
 import pytest
 
-from align.allan import allan, confidence_interval, edf_overlapping, tau_grid
+from align.noise.allan import allan, confidence_interval, edf_overlapping, tau_grid
 from align.errors import InputError
-from align.noisefit import fit_noise, noise_figures
-from align.noisesim import NoiseSpec, seed_method_a, seed_method_b, seed_restoring, simulate_noise
-from align.planner import averaging_time, model_curve, noise_target
+from align.noise.fit import fit_noise, noise_figures
+from align.noise.sim import NoiseSpec, seed_method_a, seed_method_b, seed_restoring, simulate_noise
+from align.noise.planner import averaging_time, model_curve, noise_target
 from align.units import DEG_H, parse_quantity as q
 
 from conftest import SHARED
@@ -136,7 +136,7 @@ def test_noise_figures_follow_seed_definitions():
 
 
 def test_npy_chunks_give_the_same_result(tmp_path):
-    from align.fileio import NpyChunks
+    from align.io.files import NpyChunks
 
     rng = np.random.default_rng(8)
     y = rng.normal(size=(30_000, 2)) + 1.0

@@ -7,9 +7,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from align.calibration import Calibration, calibrate_accel, ferraris
+from align.calibration.accel import Calibration, calibrate_accel, ferraris
 from align.errors import InputError, TestError
-from align.magnetometer import calibrate_magnetometer
+from align.calibration.magnetometer import calibrate_magnetometer
 from align.units import DEG
 
 from conftest import SHARED
@@ -168,7 +168,7 @@ def test_apply_accel_and_mag_round_trip(tmp_path, run_cli):
     c = calibrate_magnetometer(m, "uT", field=F)
     cal = c.correct(m)
     assert np.allclose(np.linalg.norm(cal, axis=1), F, rtol=1e-6)
-    from align.magnetometer import MagCalibration
+    from align.calibration.magnetometer import MagCalibration
 
     again = MagCalibration.from_dict(json.loads(json.dumps(c.to_dict())))
     assert np.allclose(again.correct(m), cal, rtol=1e-12)

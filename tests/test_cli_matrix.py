@@ -7,10 +7,10 @@ import sys
 import numpy as np
 import pytest
 
-from align.alignment import AlignmentResult
+from align.alignment.job import AlignmentResult
 from align.model import SensorModel
-from align.plan import Plan, Step
-from align.simulate import SessionSpec, simulate_session
+from align.alignment.plan import Plan, Step
+from align.alignment.simulate import SessionSpec, simulate_session
 from align.units import DEG, parse_quantity as q
 
 from conftest import truth_model, write_session
@@ -59,7 +59,7 @@ def test_apply_corrects_log_to_true_rates(tmp_path, run_cli):
     corrected = tmp_path / "corrected.csv"
     res = run_cli("apply", log2, "--alignment", out, "--out", corrected)
     assert res.code == 0, res.err
-    from align.fileio import read_log
+    from align.io.files import read_log
 
     _, w_hat = read_log(corrected, ["gyro_x", "gyro_y", "gyro_z"], "deg/s")
     err = np.abs(w_hat - w).max()

@@ -4,12 +4,12 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from align.alignment import AlignOptions, align
-from align.estimate import Observation, fit_rate_pairs, two_axis_error_bound
+from align.alignment.job import AlignOptions, align
+from align.alignment.estimate import Observation, fit_rate_pairs, two_axis_error_bound
 from align.model import SensorModel
-from align.plan import Plan, Step
-from align.segment import Segment
-from align.simulate import SessionSpec, simulate_session
+from align.alignment.plan import Plan, Step
+from align.alignment.segment import Segment
+from align.alignment.simulate import SessionSpec, simulate_session
 from align.units import DEG, parse_quantity as q
 
 from conftest import truth_model

@@ -27,7 +27,7 @@ def test_demo_summary_and_results(demo_dir):
     for name in ("budget", "allowable", "allan", "plan", "alignment"):
         assert (out / f"{name}.json").exists()
     align = json.loads((out / "alignment.json").read_text())
-    from align.story import demo_inputs
+    from align.present.story import demo_inputs
 
     again = out / "again"
     again.mkdir()
@@ -76,7 +76,7 @@ def test_report_in_headless_chromium(demo_dir, tmp_path):
 
 
 def test_report_command_errors(tmp_path, run_cli):
-    from align.story import DEMO
+    from align.present.story import DEMO
 
     res = run_cli("report", "--mount", DEMO / "mount.toml", "--manoeuvre", DEMO / "manoeuvre.toml",
                   "--log", tmp_path / "x.csv", "--out", tmp_path / "r.html")
@@ -90,7 +90,7 @@ def test_start_up_imports_nothing_heavy():
 
 
 def test_progress_bar_only_on_a_terminal(tmp_path):
-    from align.story import DEMO
+    from align.present.story import DEMO
 
     cmd = [sys.executable, "-m", "align.cli", "budget", str(DEMO / "mount.toml"), "--monte-carlo", "120000"]
     piped = subprocess.run(cmd, capture_output=True, text=True)

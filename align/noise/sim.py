@@ -143,7 +143,7 @@ def seed_restoring(truth: np.ndarray, fs: float, bias: float, repeatability: flo
     sequence is rescaled about its mean so that its bias stability over ``period``
     equals the stated one: ``Q' = Q B_s / B_s(real) + mean(Q) (1 - B_s / B_s(real))``.
     """
-    from .noisefit import noise_figures
+    from align.noise.fit import noise_figures
 
     rng = _rng(seed)
     dt = 1.0 / fs

@@ -31,8 +31,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from .errors import InputError
-from .units import DEG, parse_quantity
+from align.errors import InputError
+from align.units import DEG, parse_quantity
 
 ELEMENTS = ("psi_x", "psi_y", "psi_z", "phi_xy", "phi_xz", "phi_yx", "phi_yz", "phi_zx", "phi_zy")
 OUTPUTS = ("x", "y", "z", "azimuth", "elevation", "roll")
@@ -209,8 +209,8 @@ def manoeuvre_from_dict(data: dict, where: str = "manoeuvre", base_dir=None) -> 
 def _series(series: dict, limits: dict, where: str, base_dir) -> Manoeuvre:
     from pathlib import Path
 
-    from . import fileio
-    from .checks import check_log, check_time
+    from align.io import files as fileio
+    from align.alignment.checks import check_log, check_time
 
     if "file" not in series:
         raise InputError("missing file = \"rates.csv\"", f"{where}: series.file")
@@ -277,7 +277,7 @@ class Allowable:
     manoeuvre: Manoeuvre
 
     def to_dict(self) -> dict:
-        from . import CONVENTION, __version__
+        from align import CONVENTION, __version__
 
         return {
             "format": "imu-align.allowable", "version": 1, "generator": f"imu-align {__version__}",

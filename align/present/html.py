@@ -18,8 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import CONVENTION, __version__
-from .units import DEG, to_unit
+from align import CONVENTION, __version__
+from align.units import DEG, to_unit
 
 _CSS = """
 body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:1000px;margin:2em auto;padding:0 1em;color:#222}

@@ -17,19 +17,19 @@ from pathlib import Path
 
 import numpy as np
 
-from . import fileio
-from .units import DEG, DEG_H, parse_quantity as q
+from align.io import files as fileio
+from align.units import DEG, DEG_H, parse_quantity as q
 
 DEMO = Path(__file__).with_name("demo")
 
 
 def demo_inputs(out: Path, seed: int = 0) -> dict:
     """Write the demo's inputs into ``out`` and return their paths and reading options."""
-    from .model import SensorModel
-    from .noisesim import NoiseSpec, simulate_noise
-    from .plan import Plan
-    from .simulate import SessionSpec, simulate_session
-    from .units import to_unit
+    from align.model import SensorModel
+    from align.noise.sim import NoiseSpec, simulate_noise
+    from align.alignment.plan import Plan
+    from align.alignment.simulate import SessionSpec, simulate_session
+    from align.units import to_unit
 
     mount, manoeuvre = out / "mount.toml", out / "manoeuvre.toml"
     fileio.write_text(mount, (DEMO / "mount.toml").read_text())
@@ -74,8 +74,8 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
     from mechanics.mount import mount_from_dict
     from mechanics.render import assembly_png, histogram_png
 
-    from . import report
-    from .sensitivity import allowable, manoeuvre_from_dict, margins
+    import align.present.html as report
+    from align.sensitivity.allowable import allowable, manoeuvre_from_dict, margins
 
     inputs = {"mount": (str(mount), Path(mount).read_text()), "manoeuvre": (str(manoeuvre), Path(manoeuvre).read_text())}
     m = mount_from_dict(fileio.read_toml(mount), str(mount), Path(mount).parent)
@@ -95,8 +95,8 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
              f"{'PASSES' if results['check']['pass'] else 'FAILS'} the check"]
     plan_dict = allan_dict = plot = None
     if allan is not None:
-        from .noisereport import allan_plot_png, run_allan
-        from .planner import make_plan
+        from align.noise.job import allan_plot_png, run_allan
+        from align.noise.planner import make_plan
 
         names = [c.strip() for c in allan_columns.split(",")]
         data, fs = fileio.read_static(allan, names, allan_rate_hz)
@@ -114,8 +114,8 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
     sections.append(report.allan_section(allan_dict, plot, plan_dict) if allan is not None else
                     report.Section("Noise and test planning", "<p>No static record given (--allan).</p>"))
     if log is not None and plan is not None:
-        from .alignment import align
-        from .plan import Plan
+        from align.alignment.job import align
+        from align.alignment.plan import Plan
 
         the_plan = Plan.from_dict(fileio.read_toml(plan), str(plan))
         t, g = fileio.read_log(log, ["gyro_x", "gyro_y", "gyro_z"], gyro_units)

@@ -27,11 +27,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .earth import vertical_rate
-from .errors import TestError
-from .model import nearest_rotation
-from .plan import Plan, axis_name
-from .segment import Segment, integrate
+from align.earth import vertical_rate
+from align.errors import TestError
+from align.model import nearest_rotation
+from align.alignment.plan import Plan, axis_name
+from align.alignment.segment import Segment, integrate
 
 
 @dataclass(frozen=True)

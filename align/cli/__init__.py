@@ -30,7 +30,7 @@ def _columns(text: str, rate_hz: Optional[float]) -> tuple[Optional[str], list[s
     names = [c.strip() for c in text.split(",") if c.strip()]
     if rate_hz is None:
         if len(names) != 4:
-            from .errors import InputError
+            from align.errors import InputError
 
             raise InputError("give four names: time,x,y,z (or three with --rate-hz)", "--columns")
         return names[0], names[1:]
@@ -60,15 +60,15 @@ def matrix(
     earth: bool = typer.Option(True, help="Correct the vertical Earth rate when the plan gives a latitude."),
 ) -> None:
     """Alignment matrix M and A = M^-1 from rate-table data."""
-    from . import fileio
-    from .alignment import AlignOptions, align
-    from .plan import Plan
-    from .segment import SegmentOptions, segments_from_ranges
-    from .summary import alignment_summary
-    from .units import parse_quantity as q
+    from align.io import files as fileio
+    from align.alignment.job import AlignOptions, align
+    from align.alignment.plan import Plan
+    from align.alignment.segment import SegmentOptions, segments_from_ranges
+    from align.present.text import alignment_summary
+    from align.units import parse_quantity as q
 
     if two_axis_variant not in ("procrustes", "cross"):
-        from .errors import InputError
+        from align.errors import InputError
 
         raise InputError("choose procrustes or cross", "--two-axis-variant")
     time_col, cols = _columns(columns, rate_hz)
@@ -100,8 +100,8 @@ def matrix(
     if json_out is not None:
         fileio.write_json(json_out, result.to_dict())
     if c_header is not None:
-        from . import CONVENTION
-        from .units import to_unit
+        from align import CONVENTION
+        from align.units import to_unit
 
         text = fileio.c_header("IMU_ALIGN", result.A, to_unit(result.bias, gyro_units), gyro_units,
                                f"imu-align alignment from {log.name}\n{CONVENTION}")
@@ -122,14 +122,14 @@ def apply(
     """Correct a log: gyro w = A (g - b); accelerometer M^-1 (a - b); magnetometer soft_iron (m - hard_iron)."""
     import numpy as np
 
-    from . import fileio
-    from .alignment import FORMAT as ALIGN_FORMAT
-    from .alignment import AlignmentResult
-    from .calibration import Calibration
-    from .errors import InputError
-    from .magnetometer import MagCalibration
-    from .model import SensorModel
-    from .units import parse_unit, to_unit
+    from align.io import files as fileio
+    from align.alignment.job import FORMAT as ALIGN_FORMAT
+    from align.alignment.job import AlignmentResult
+    from align.calibration.accel import Calibration
+    from align.errors import InputError
+    from align.calibration.magnetometer import MagCalibration
+    from align.model import SensorModel
+    from align.units import parse_unit, to_unit
 
     d = fileio.read_json(alignment)
     fmt = d.get("format")
@@ -166,7 +166,7 @@ def apply(
 
 
 def _kind_of(unit: str) -> str:
-    from .units import DIMENSIONS, parse_unit
+    from align.units import DIMENSIONS, parse_unit
 
     dim = parse_unit(unit).dim
     for name in ("acceleration", "magnetic_field", "counts", "angular_rate"):
@@ -195,13 +195,15 @@ def simulate(
     import numpy as np
     from scipy.spatial.transform import Rotation
 
-    from . import CONVENTION, fileio
-    from .errors import InputError
-    from .model import SensorModel
-    from .plan import Plan
-    from .simulate import SessionSpec, simulate_session
-    from .units import DEG, to_unit
-    from .units import parse_quantity as q
+    from align import CONVENTION
+
+    from align.io import files as fileio
+    from align.errors import InputError
+    from align.model import SensorModel
+    from align.alignment.plan import Plan
+    from align.alignment.simulate import SessionSpec, simulate_session
+    from align.units import DEG, to_unit
+    from align.units import parse_quantity as q
 
     if not out_dir.is_dir():
         raise InputError("output folder does not exist", str(out_dir))
@@ -247,9 +249,9 @@ def budget(
     exaggerate: float = typer.Option(30.0, help="Angle exaggeration of --picture and --glb."),
 ) -> None:
     """Mounting-misalignment budget: source formulas, worst case and Monte Carlo."""
-    from . import fileio
-    from .errors import InputError
-    from .summary import budget_summary
+    from align.io import files as fileio
+    from align.errors import InputError
+    from align.present.text import budget_summary
     from mechanics.budget import budget as make_budget
     from mechanics.budget import monte_carlo as run_mc
     from mechanics.mount import mount_from_dict
@@ -291,9 +293,9 @@ def allowable(
     symbolic: Optional[str] = typer.Option(None, help="Also print the sympy response and sensitivity: pretty | latex."),
 ) -> None:
     """Allowable misalignment per element for a manoeuvre, the binding element and the cone."""
-    from . import fileio
-    from .sensitivity import allowable as compute, manoeuvre_from_dict, symbolic_text
-    from .summary import allowable_summary
+    from align.io import files as fileio
+    from align.sensitivity.allowable import allowable as compute, manoeuvre_from_dict, symbolic_text
+    from align.present.text import allowable_summary
 
     man = manoeuvre_from_dict(fileio.read_toml(manoeuvre), str(manoeuvre), manoeuvre.parent)
     if symbolic is not None:
@@ -312,10 +314,11 @@ def check(
     json_out: Optional[Path] = typer.Option(None, "--json", help="Write the element table as JSON."),
 ) -> None:
     """The mounting budget against the allowance; exit status 4 when an element fails."""
-    from . import CONVENTION, fileio
-    from .errors import InputError
-    from .sensitivity import allowable as compute, manoeuvre_from_dict, margins
-    from .summary import margin_summary
+    from align import CONVENTION
+    from align.io import files as fileio
+    from align.errors import InputError
+    from align.sensitivity.allowable import allowable as compute, manoeuvre_from_dict, margins
+    from align.present.text import margin_summary
     from mechanics.budget import budget as make_budget
     from mechanics.mount import mount_from_dict
 
@@ -359,12 +362,12 @@ def allan(
 ) -> None:
     """Allan deviation, noise-model fit and noise figures of static recordings."""
 
-    from . import fileio
-    from .errors import InputError
-    from .noisereport import allan_plot_png, run_allan
-    from .summary import allan_summary
-    from .units import parse_quantity as q
-    from .units import parse_unit
+    from align.io import files as fileio
+    from align.errors import InputError
+    from align.noise.job import allan_plot_png, run_allan
+    from align.present.text import allan_summary
+    from align.units import parse_quantity as q
+    from align.units import parse_unit
 
     unit = units or gyro_units
     parse_unit(unit, None if units else "angular_rate", "--units" if units else "--gyro-units")
@@ -389,7 +392,7 @@ def allan(
     if (rate is None) != (accuracy is None):
         raise InputError("give both --rate and --accuracy to plan", "--rate")
     if rate is not None:
-        from .planner import make_plan
+        from align.noise.planner import make_plan
 
         r = job.result
         worst = r.adev.max(axis=0)
@@ -399,7 +402,7 @@ def allan(
         d["plan"] = pl.to_dict()
     typer.echo(allan_summary(d))
     if "plan" in d:
-        from .summary import plan_summary
+        from align.present.text import plan_summary
 
         typer.echo("\n" + plan_summary(d["plan"]))
     png = allan_plot_png(job, target, chosen) if plot is not None else None
@@ -410,7 +413,7 @@ def allan(
 
 
 def _taus(text: str) -> list[float]:
-    from .errors import InputError
+    from align.errors import InputError
 
     try:
         taus = [float(v) for v in text.split(",") if v.strip()]
@@ -439,12 +442,12 @@ def plan(
     """Averaging time per table step for an alignment goal (Example 3), and the whole plan."""
     import numpy as np
 
-    from . import fileio
-    from .errors import InputError
-    from .planner import make_plan, model_curve
-    from .summary import plan_summary
-    from .units import parse_quantity as q
-    from .units import parse_unit
+    from align.io import files as fileio
+    from align.errors import InputError
+    from align.noise.planner import make_plan, model_curve
+    from align.present.text import plan_summary
+    from align.units import parse_quantity as q
+    from align.units import parse_unit
 
     given = [x is not None for x in (arw, imu, allan_json)]
     if sum(given) != 1:
@@ -462,7 +465,7 @@ def plan(
         label = f"model: ARW {arw}" + (f", bias instability {bias_instability}" if b else "") + (f", RRW {rate_random_walk}" if k else "")
         result = make_plan(w, a, noise_ratio, label, sigma=model_curve(n, b, k), **common)
     elif imu is not None:
-        from .parts import get_part
+        from align.parts import get_part
 
         part = get_part(imu, "--imu")
         n = part.si("arw", "angle_random_walk") or part.si("noise_density", "angle_random_walk")
@@ -502,9 +505,9 @@ def report(
     seed: int = typer.Option(0, help="Monte Carlo seed."),
 ) -> None:
     """One self-contained HTML report: budget, allowance, noise plan and alignment."""
-    from . import fileio
-    from .errors import InputError
-    from .story import build_report
+    from align.io import files as fileio
+    from align.errors import InputError
+    from align.present.story import build_report
 
     if (log is None) != (plan is None):
         raise InputError("give --log and --plan together", "--log" if log is None else "--plan")
@@ -521,8 +524,8 @@ def demo(
 ) -> None:
     """The whole story on bundled inputs (Examples 1-3, simulated records): summary and report."""
 
-    from . import fileio
-    from .story import build_report, demo_inputs
+    from align.io import files as fileio
+    from align.present.story import build_report, demo_inputs
 
     out.mkdir(parents=True, exist_ok=True)
     inp = demo_inputs(out)
@@ -546,8 +549,8 @@ app.add_typer(calibrate_app, name="calibrate")
 
 
 def _calibration_file(sensors: dict, inputs: dict) -> dict:
-    from . import __version__
-    from .calibration import CONVENTION
+    from align import __version__
+    from align.calibration.accel import CONVENTION
 
     d = {"format": "imu-align.calibration", "version": 1, "generator": f"imu-align {__version__}",
          "convention": CONVENTION, "inputs": inputs}
@@ -573,11 +576,11 @@ def calibrate_ferraris(
 ) -> None:
     """A Ferraris session (six static faces and a turn about each axis), as imucal records it."""
 
-    from . import fileio
-    from .calibration import ferraris, imucal_dict
-    from .errors import InputError
-    from .summary import calibration_summary
-    from .units import parse_quantity as q
+    from align.io import files as fileio
+    from align.calibration.accel import ferraris, imucal_dict
+    from align.errors import InputError
+    from align.present.text import calibration_summary
+    from align.units import parse_quantity as q
 
     if bias not in ("pairwise", "lsq"):
         raise InputError("choose pairwise or lsq", "--bias")
@@ -619,13 +622,13 @@ def calibrate_accel_cmd(
     """Accelerometer multi-position calibration (known orientations, or |a| = g over many attitudes)."""
     import numpy as np
 
-    from . import fileio
-    from .calibration import accel_session
-    from .checks import check_log
-    from .segment import static_intervals
-    from .summary import calibration_summary
-    from .units import parse_unit
-    from .units import parse_quantity as q
+    from align.io import files as fileio
+    from align.calibration.accel import accel_session
+    from align.alignment.checks import check_log
+    from align.alignment.segment import static_intervals
+    from align.present.text import calibration_summary
+    from align.units import parse_unit
+    from align.units import parse_quantity as q
 
     time_col, cols = _columns(columns, rate_hz)
     counts = parse_unit(units).dim == parse_unit("counts").dim
@@ -657,11 +660,11 @@ def calibrate_mag(
     """Magnetometer hard and soft iron (ellipsoid fit with coverage gates)."""
     import numpy as np
 
-    from . import fileio
-    from .errors import InputError
-    from .magnetometer import alignment_to_gravity, calibrate_magnetometer
-    from .summary import magnetometer_summary
-    from .units import parse_quantity, parse_unit
+    from align.io import files as fileio
+    from align.errors import InputError
+    from align.calibration.magnetometer import alignment_to_gravity, calibrate_magnetometer
+    from align.present.text import magnetometer_summary
+    from align.units import parse_quantity, parse_unit
 
     names = [c.strip() for c in columns.split(",")]
     if mag_units[:1].isdigit() or mag_units[:1] == ".":
@@ -717,7 +720,7 @@ class _progress:
 
 def main() -> None:
     """Entry point: run the app, turning user-facing errors into one line and an exit code."""
-    from .errors import AlignError
+    from align.errors import AlignError
 
     try:
         code = app(standalone_mode=False)  # a typer.Exit(code) comes back as the return value here
@@ -739,6 +742,3 @@ def main() -> None:
     if isinstance(code, int) and code:
         sys.exit(code)
 
-
-if __name__ == "__main__":
-    main()

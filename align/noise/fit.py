@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .allan import NOISE_ALPHA, AllanResult, confidence_interval, edf_overlapping
+from align.noise.allan import NOISE_ALPHA, AllanResult, confidence_interval, edf_overlapping
 
 TERMS = ("quantization", "white", "flicker", "random_walk", "ramp")
 _LN = 2 * np.log(2) / np.pi

@@ -11,9 +11,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .allan import AllanResult, allan
-from .noisefit import TERMS, fit_noise, model_adev
-from .units import parse_unit, to_unit
+from align.noise.allan import AllanResult, allan
+from align.noise.fit import TERMS, fit_noise, model_adev
+from align.units import parse_unit, to_unit
 
 #: display units of the five terms for gyros and accelerometers
 _GYRO = ("deg", "deg/sqrt(h)", "deg/h", "deg/h/sqrt(h)", "deg/h^2")
@@ -39,7 +39,7 @@ class AllanJob:
     inputs: list = field(default_factory=list)
 
     def to_dict(self) -> dict:
-        from . import __version__
+        from align import __version__
 
         r, u = self.result, self.units
         tu = term_units(u)

@@ -18,10 +18,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .earth import earth_rate_in_frame
-from .model import SensorModel
-from .plan import Plan
-from .units import DEG, DEG_S
+from align.earth import earth_rate_in_frame
+from align.model import SensorModel
+from align.alignment.plan import Plan
+from align.units import DEG, DEG_S
 
 
 @dataclass(frozen=True)

@@ -24,10 +24,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import __version__
-from .checks import check_finite
-from .errors import InputError, TestError
-from .units import DEG, to_unit
+from align import __version__
+from align.alignment.checks import check_finite
+from align.errors import InputError, TestError
+from align.units import DEG, to_unit
 
 MODELS = ("sphere", "diagonal", "symmetric")
 CONVENTION = "m_cal = soft_iron (m_raw - hard_iron)"
@@ -77,7 +77,7 @@ class MagCalibration:
 
     @classmethod
     def from_dict(cls, d: dict, where: str = "magnetometer") -> "MagCalibration":
-        from .units import parse_unit
+        from align.units import parse_unit
 
         try:
             u = d["units"]["hard_iron"]

@@ -19,9 +19,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import InputError, TestError
-from .plan import Plan
-from .units import DEG_S, unit_mixup_hint
+from align.errors import InputError, TestError
+from align.alignment.plan import Plan
+from align.units import DEG_S, unit_mixup_hint
 
 
 @dataclass(frozen=True)

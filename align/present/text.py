@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .alignment import AlignmentResult
-from .units import DEG, to_unit
+from align.alignment.job import AlignmentResult
+from align.units import DEG, to_unit
 
 
 def matrix_text(m: np.ndarray, sigma: np.ndarray | None = None, digits: int = 6, indent: str = "  ") -> str:

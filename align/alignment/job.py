@@ -15,17 +15,17 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from . import CONVENTION, __version__
-from .checks import (Check, check_directions, check_durations, check_log, check_residuals,
+from align import CONVENTION, __version__
+from align.alignment.checks import (Check, check_directions, check_durations, check_log, check_residuals,
                      check_saturation, check_scale, check_span)
-from .earth import EARTH_RATE, vertical_rate
-from .errors import InputError
-from .estimate import (alignment_sigma, fit_angle_pairs, fit_lsq, fit_rate_pairs, observe,
+from align.earth import EARTH_RATE, vertical_rate
+from align.errors import InputError
+from align.alignment.estimate import (alignment_sigma, fit_angle_pairs, fit_lsq, fit_rate_pairs, observe,
                        two_axis, two_axis_error_bound)
-from .model import angles, check_handedness
-from .plan import Plan
-from .segment import Segment, SegmentOptions, noise_sigma, segment_log
-from .units import DEG, DEG_H, parse_unit, to_unit
+from align.model import angles, check_handedness
+from align.alignment.plan import Plan
+from align.alignment.segment import Segment, SegmentOptions, noise_sigma, segment_log
+from align.units import DEG, DEG_H, parse_unit, to_unit
 
 FORMAT = "imu-align.alignment"
 FORMAT_VERSION = 1

@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import InputError
-from .units import format_quantity, parse_quantity
+from align.errors import InputError
+from align.units import format_quantity, parse_quantity
 
 _AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 

@@ -26,11 +26,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import __version__
-from .errors import InputError, TestError
-from .estimate import Observation, fit_lsq
-from .segment import Segment
-from .units import STANDARD_GRAVITY, to_unit
+from align import __version__
+from align.errors import InputError, TestError
+from align.alignment.estimate import Observation, fit_lsq
+from align.alignment.segment import Segment
+from align.units import STANDARD_GRAVITY, to_unit
 
 FORMAT = "imu-align.calibration"
 CONVENTION = "raw = M true + bias; true = M^-1 (raw - bias); rows of M are sensor axes"
@@ -73,7 +73,7 @@ class Calibration:
 
     @classmethod
     def from_dict(cls, d: dict, where: str = "calibration") -> "Calibration":
-        from .units import parse_unit
+        from align.units import parse_unit
 
         try:
             u = d["units"]["bias"]
@@ -134,7 +134,7 @@ def accel_session(t: np.ndarray, a: np.ndarray, intervals: list, positions: list
     positions : list of dict or None
         Each with ``up`` (``"+x"`` or ``[x, y, z]``), optional ``name``, ``start``, ``end``, ``holdout``.
     """
-    from .plan import parse_axis
+    from align.alignment.plan import parse_axis
 
     if positions is None:
         means = static_means(a, {f"interval {k + 1}": r for k, r in enumerate(intervals)}, 0.02, f"{where}: ")
@@ -289,8 +289,8 @@ def ferraris(acc: np.ndarray, gyr: np.ndarray, fs: float, sections: dict, turn_a
     turn_angle : float
         Signed angle of each turn about the axis pointing up, rad (imucal: -360 deg).
     """
-    from .alignment import AlignOptions, align
-    from .plan import Plan, Step
+    from align.alignment.job import AlignOptions, align
+    from align.alignment.plan import Plan, Step
 
     need = list(FACES) + ["x_rot", "y_rot", "z_rot"]
     missing = [k for k in need if k not in sections]

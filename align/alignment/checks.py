@@ -17,10 +17,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import HandednessError, InputError, TestError
-from .plan import Plan, axis_name
-from .segment import Segment
-from .units import format_quantity, unit_mixup_hint
+from align.errors import HandednessError, InputError, TestError
+from align.alignment.plan import Plan, axis_name
+from align.alignment.segment import Segment
+from align.units import format_quantity, unit_mixup_hint
 
 
 @dataclass(frozen=True)

@@ -22,8 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError
-from .units import parse_unit
+from align.errors import InputError
+from align.units import parse_unit
 
 
 def _exists(path: str | Path) -> Path:
@@ -294,7 +294,7 @@ def read_static(log: str | Path, names: list[str], rate_hz: float | None):
     _, data = read_columns(log, wanted)
     if rate_hz is not None:
         return data, float(rate_hz)
-    from .checks import check_log, check_time
+    from align.alignment.checks import check_log, check_time
 
     t = data[:, 0]
     check_log(t, data[:, 1:], str(log), min_rows=3)

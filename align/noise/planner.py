@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .units import DEG_H
+from align.units import DEG_H
 
 _LN = 2 * np.log(2) / np.pi
 
@@ -114,7 +114,7 @@ class PlanResult:
     source: str
 
     def to_dict(self) -> dict:
-        from . import __version__
+        from align import __version__
 
         a = self.averaging
         dwell = None if a.tau is None else a.tau + self.settle

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import InputError
+from align.errors import InputError
 
 #: power-law exponent alpha of the frequency PSD (S_y ~ f^alpha) for each noise term
 NOISE_ALPHA = {"quantization": 2, "white": 0, "flicker": -1, "random_walk": -2, "ramp": -2}
@@ -70,7 +70,7 @@ def tau_grid(n: int, fs: float, grid: str | list = "dense", per_decade: int = 10
 
 def _get_kernels():
     """The compiled ``avar_sums`` and ``mvar_sums`` (numba is imported only when needed)."""
-    from ._allan_kernels import avar_sums, mvar_sums
+    from align.noise._kernels import avar_sums, mvar_sums
 
     return avar_sums, mvar_sums
 
