@@ -1,11 +1,37 @@
 """User-facing errors.
 
 Every problem a user can fix (a bad file, a bad field, a bad test) raises a
-subclass of :class:`AlignError`. The command line turns it into one line on
-stderr and a non-zero exit status; the library never prints and never exits.
+subclass of :class:`AlignError`. The library names the inputs it concerns in
+its own terms (``gyro_units``, ``rate_hz``); the command line alone turns such
+a name into its flag, the error into one line on stderr and an exit status.
+The library never prints and never exits.
+
+Messages and ``where`` may name an input as a placeholder: ``{gyro_units}``
+(the input) or ``{gyro_units=deg/s}`` (the input set to a value). ``str(error)``
+renders them in Python terms (``gyro_units``, ``gyro_units='deg/s'``);
+:meth:`AlignError.render` takes the caller's own spelling (the CLI's flags).
+
+Public names
+------------
+AlignError, InputError, UnitError, TestError, HandednessError, CheckFailed, field_names
 """
 
 from __future__ import annotations
+
+import re
+from collections.abc import Callable
+
+#: a placeholder for an input: ``{name}`` or ``{name=value}``
+_PLACEHOLDER = re.compile(r"\{([a-z][a-z0-9_]*)(?:=([^{}]*))?\}")
+
+
+def _python_spelling(name: str, value: str | None) -> str:
+    return name if value is None else f"{name}={value!r}"
+
+
+def field_names(text: str) -> list[str]:
+    """The input names used as placeholders in ``text`` (in order)."""
+    return [m.group(1) for m in _PLACEHOLDER.finditer(text)]
 
 
 class AlignError(Exception):
@@ -14,9 +40,11 @@ class AlignError(Exception):
     Parameters
     ----------
     message : str
-        One line: what is wrong and what to do.
+        One line: what is wrong and what to do. May hold ``{name}`` /
+        ``{name=value}`` placeholders for inputs.
     where : str, optional
-        The file, field or segment concerned; prefixed to the message.
+        The file, field, segment or input (a placeholder) concerned; prefixed
+        to the message.
     """
 
     exit_code = 2
@@ -24,7 +52,20 @@ class AlignError(Exception):
     def __init__(self, message: str, where: str | None = None) -> None:
         self.where = where
         self.message = message
-        super().__init__(f"{where}: {message}" if where else message)
+        super().__init__(self.render())
+
+    @property
+    def fields(self) -> list[str]:
+        """Inputs named by the error (placeholders in ``where`` and the message)."""
+        return field_names(f"{self.where or ''} {self.message}")
+
+    def render(self, spell: Callable[[str, str | None], str] = _python_spelling) -> str:
+        """The error as one line, inputs spelled by ``spell(name, value_or_None)``."""
+
+        def sub(text: str) -> str:
+            return _PLACEHOLDER.sub(lambda m: spell(m.group(1), m.group(2)), text)
+
+        return f"{sub(self.where)}: {sub(self.message)}" if self.where else sub(self.message)
 
 
 class InputError(AlignError):
@@ -45,3 +86,9 @@ class TestError(AlignError):
 
 class HandednessError(TestError):
     """``det(M) <= 0``: an axis is wired or mounted backwards."""
+
+
+class CheckFailed(AlignError):
+    """A result failed a stated requirement (a budget against its allowance)."""
+
+    exit_code = 4

@@ -21,7 +21,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from align.io import files as fileio  # noqa: E402
+from align.io import write_csv, write_text  # noqa: E402
 from align.model import SensorModel  # noqa: E402
 from align.alignment.plan import Plan, Step  # noqa: E402
 from align.alignment.simulate import SessionSpec, simulate_session  # noqa: E402
@@ -38,8 +38,8 @@ def make_session(folder: Path) -> tuple[Path, Path, int]:
     model = SensorModel.from_small_angles(0.002, -0.001, 0.003, bias=[0.001, -0.002, 0.0005])
     t, g, _ = simulate_session(plan, model, spec, 0)
     log, plan_path = folder / "session.csv", folder / "plan.toml"
-    fileio.write_csv(log, ["time", "gyro_x", "gyro_y", "gyro_z"], np.column_stack([t, to_unit(g, "deg/s")]))
-    fileio.write_text(plan_path, plan.to_toml())
+    write_csv(log, ["time", "gyro_x", "gyro_y", "gyro_z"], np.column_stack([t, to_unit(g, "deg/s")]))
+    write_text(plan_path, plan.to_toml())
     return log, plan_path, len(t)
 
 

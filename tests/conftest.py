@@ -30,12 +30,12 @@ def truth_model(seed: int = 0, rot_deg: float = 0.6, scale_sd: float = 3e-3, del
 
 def write_session(folder: Path, t: np.ndarray, g: np.ndarray, plan, units: str = "deg/s") -> tuple[Path, Path]:
     """Write a simulated session as the CLI reads it."""
-    from align.io import files as fileio
+    from align.io import write_csv, write_text
     from align.units import to_unit
 
     log, plan_path = folder / "session.csv", folder / "plan.toml"
-    fileio.write_csv(log, ["time", "gyro_x", "gyro_y", "gyro_z"], np.column_stack([t, to_unit(g, units)]))
-    fileio.write_text(plan_path, plan.to_toml())
+    write_csv(log, ["time", "gyro_x", "gyro_y", "gyro_z"], np.column_stack([t, to_unit(g, units)]))
+    write_text(plan_path, plan.to_toml())
     return log, plan_path
 
 

@@ -136,7 +136,7 @@ def test_noise_figures_follow_seed_definitions():
 
 
 def test_npy_chunks_give_the_same_result(tmp_path):
-    from align.io.files import NpyChunks
+    from align.io import NpyChunks
 
     rng = np.random.default_rng(8)
     y = rng.normal(size=(30_000, 2)) + 1.0

@@ -59,7 +59,7 @@ def test_apply_corrects_log_to_true_rates(tmp_path, run_cli):
     corrected = tmp_path / "corrected.csv"
     res = run_cli("apply", log2, "--alignment", out, "--out", corrected)
     assert res.code == 0, res.err
-    from align.io.files import read_log
+    from align.io import read_log
 
     _, w_hat = read_log(corrected, ["gyro_x", "gyro_y", "gyro_z"], "deg/s")
     err = np.abs(w_hat - w).max()

@@ -7,7 +7,7 @@ import pytest
 from scipy.optimize import linprog
 
 from align.errors import InputError
-from align.io.files import read_toml
+from align.io import read_toml
 from align.units import DEG
 from mechanics.budget import budget, monte_carlo
 from mechanics.formulas import rss, screw_radius, skew_from_screws, tilt_from_ledges

@@ -8,7 +8,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from align.errors import InputError
-from align.io.files import read_toml
+from align.io import read_toml
 from align.sensitivity.allowable import (ELEMENTS, allowable, closed_form_errors, manoeuvre_from_dict, matrix_from_angles,
                                output_errors, response, sensitivity, symbolic, symbolic_text)
 from align.units import DEG

@@ -7,7 +7,7 @@ misalignment being measured is a few degrees, not a re-mounted IMU).
 
 Public names
 ------------
-Check, check_finite, check_time, check_log, check_span, check_saturation, check_durations,
+Check, check_span, check_saturation, check_durations,
 check_directions, check_scale, check_residuals
 """
 
@@ -21,10 +21,11 @@ from align.errors import HandednessError, InputError, TestError
 from align.alignment.plan import Plan, axis_name
 from align.alignment.segment import Segment
 from align.units import format_quantity, unit_mixup_hint
+from align.values import Value
 
 
-@dataclass(frozen=True)
-class Check:
+@dataclass(frozen=True, eq=False)
+class Check(Value):
     """One check's outcome: ``status`` is ``"pass"`` or ``"warn"``."""
 
     name: str
@@ -33,43 +34,6 @@ class Check:
 
     def to_dict(self) -> dict:
         return {"name": self.name, "status": self.status, "detail": self.detail}
-
-
-def check_finite(x: np.ndarray, where: str, t: np.ndarray | None = None) -> None:
-    """Reject rows of ``x`` (n, k) (or times ``t``) that are NaN or infinite, naming the first."""
-    bad = ~np.isfinite(x).all(axis=1)
-    if t is not None:
-        bad |= ~np.isfinite(t)
-    if bad.any():
-        rows = np.flatnonzero(bad)
-        raise InputError(f"{len(rows)} rows with NaN or inf (first at data row {rows[0] + 1}); remove or repair them", where)
-
-
-def check_time(t: np.ndarray, where: str, gap: float | None = None, jitter: bool = False) -> None:
-    """Time must increase; with ``gap``, no step may exceed ``gap`` times the median step
-    (and, with ``jitter``, none may fall below ``2 - gap`` times it: uniform sampling)."""
-    dt = np.diff(t)
-    if np.any(dt <= 0):
-        k = int(np.argmax(dt <= 0))
-        raise InputError(f"time does not increase at data row {k + 2} (t={t[k + 1]!r} after {t[k]!r}); "
-                         "sort the log or fix the time column", where)
-    if gap is None or len(dt) == 0:
-        return
-    med = float(np.median(dt))
-    off = (dt > gap * med) | ((dt < (2 - gap) * med) if jitter else False)
-    if off.any():
-        k = int(np.argmax(off))
-        raise InputError(f"{int(off.sum())} time gaps{' or jitter' if jitter else ''} beyond {100 * (gap - 1):g} % of the "
-                         f"{med:.4g} s median step: gap in the time series at t={t[k]:.6g} s (step {dt[k]:.4g} s); "
-                         "resample or split the file", where)
-
-
-def check_log(t: np.ndarray, g: np.ndarray, where: str, min_rows: int = 10) -> None:
-    """Reject NaN or infinite rows, non-increasing time and logs that are too short."""
-    if len(t) < min_rows:
-        raise InputError(f"only {len(t)} rows; at least {min_rows} are needed", where)
-    check_finite(g, where, t)
-    check_time(t, where)
 
 
 def check_span(plan: Plan, allow_two_axis: bool = False) -> int | None:

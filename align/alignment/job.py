@@ -12,11 +12,12 @@ AlignOptions, AlignmentResult, SegmentReport, align, FORMAT, FORMAT_VERSION
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import ClassVar
 
 import numpy as np
 
-from align import CONVENTION, __version__
-from align.alignment.checks import (Check, check_directions, check_durations, check_log, check_residuals,
+from align import CONVENTION
+from align.alignment.checks import (Check, check_directions, check_durations, check_residuals,
                      check_saturation, check_scale, check_span)
 from align.earth import EARTH_RATE, vertical_rate
 from align.errors import InputError
@@ -24,8 +25,11 @@ from align.alignment.estimate import (alignment_sigma, fit_angle_pairs, fit_lsq,
                        two_axis, two_axis_error_bound)
 from align.model import angles, check_handedness
 from align.alignment.plan import Plan
+from align.io import check_log
 from align.alignment.segment import Segment, SegmentOptions, noise_sigma, segment_log
+from align.results import Result, register
 from align.units import DEG, DEG_H, parse_unit, to_unit
+from align.values import Value
 
 FORMAT = "imu-align.alignment"
 FORMAT_VERSION = 1
@@ -69,8 +73,8 @@ class AlignOptions:
     earth_correction: bool = True
 
 
-@dataclass(frozen=True)
-class SegmentReport:
+@dataclass(frozen=True, eq=False)
+class SegmentReport(Value):
     """A segment as used in the fit; ``residual`` in rad/s (dwells, static) or rad (turns)."""
 
     name: str
@@ -83,8 +87,9 @@ class SegmentReport:
     noise: tuple[float, float, float]
 
 
-@dataclass(frozen=True)
-class AlignmentResult:
+@register
+@dataclass(frozen=True, eq=False)
+class AlignmentResult(Result):
     """Result of an electronic alignment (``g = M w + b``, ``w = A (g - b)``).
 
     ``bias`` and ``sigma_bias`` are rad/s; ``M``, ``A`` and their sigmas are
@@ -107,6 +112,10 @@ class AlignmentResult:
     inferred_axis: int | None = None
     inputs: dict = field(default_factory=dict)
 
+    FORMAT: ClassVar[str] = FORMAT
+    VERSION: ClassVar[int] = FORMAT_VERSION
+    CONVENTION: ClassVar[str] = CONVENTION
+
     @property
     def angles(self):
         return angles(self.M)
@@ -118,13 +127,9 @@ class AlignmentResult:
         pairs = ("xy", "xz", "yz")
         phi = {f"phi_{'xyz'[i]}{'xyz'[j]}": float(ang.phi[i, j] / DEG) for i in range(3) for j in range(3) if i != j}
         return {
-            "format": FORMAT,
-            "version": FORMAT_VERSION,
-            "generator": f"imu-align {__version__}",
-            "convention": CONVENTION,
+            **self.envelope({"M": "1", "A": "1", "bias": u, "angles": "deg",
+                             "residual_rate": u, "residual_angle": "deg", "time": "s"}),
             "sensor": "gyroscope",
-            "units": {"M": "1", "A": "1", "bias": u, "angles": "deg",
-                      "residual_rate": u, "residual_angle": "deg", "time": "s"},
             "method": self.method,
             "M": self.M.tolist(),
             "A": self.A.tolist(),
@@ -160,10 +165,7 @@ class AlignmentResult:
     @classmethod
     def from_dict(cls, d: dict, where: str = "result") -> "AlignmentResult":
         """Read the form written by :meth:`to_dict` (any version up to the current one)."""
-        if d.get("format") != FORMAT:
-            raise InputError(f"not an imu-align alignment result (format {d.get('format')!r})", where)
-        if not isinstance(d.get("version"), int) or d["version"] > FORMAT_VERSION:
-            raise InputError(f"result version {d.get('version')!r} is newer than this imu-align reads ({FORMAT_VERSION})", where)
+        cls.check_envelope(d, where)
         try:
             u = d["units"]["bias"]
             f = parse_unit(u, "angular_rate", f"{where}: units.bias").factor
@@ -191,11 +193,6 @@ class AlignmentResult:
             )
         except (KeyError, TypeError, ValueError) as exc:
             raise InputError(f"malformed alignment result ({exc!r}); regenerate it with imu-align matrix", where) from None
-
-    def __eq__(self, other) -> bool:  # arrays make the generated __eq__ ambiguous
-        return isinstance(other, AlignmentResult) and self.to_dict() == other.to_dict()
-
-    __hash__ = None
 
 
 def _measured_turns(obs, plan: Plan, bias: np.ndarray):

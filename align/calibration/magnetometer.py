@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from align import __version__
-from align.alignment.checks import check_finite
+from align.io import check_finite
 from align.errors import InputError, TestError
 from align.units import DEG, to_unit
 

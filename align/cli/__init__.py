@@ -60,7 +60,7 @@ def matrix(
     earth: bool = typer.Option(True, help="Correct the vertical Earth rate when the plan gives a latitude."),
 ) -> None:
     """Alignment matrix M and A = M^-1 from rate-table data."""
-    from align.io import files as fileio
+    import align.io as fileio
     from align.alignment.job import AlignOptions, align
     from align.alignment.plan import Plan
     from align.alignment.segment import SegmentOptions, segments_from_ranges
@@ -122,7 +122,7 @@ def apply(
     """Correct a log: gyro w = A (g - b); accelerometer M^-1 (a - b); magnetometer soft_iron (m - hard_iron)."""
     import numpy as np
 
-    from align.io import files as fileio
+    import align.io as fileio
     from align.alignment.job import FORMAT as ALIGN_FORMAT
     from align.alignment.job import AlignmentResult
     from align.calibration.accel import Calibration
@@ -197,7 +197,7 @@ def simulate(
 
     from align import CONVENTION
 
-    from align.io import files as fileio
+    import align.io as fileio
     from align.errors import InputError
     from align.model import SensorModel
     from align.alignment.plan import Plan
@@ -249,7 +249,7 @@ def budget(
     exaggerate: float = typer.Option(30.0, help="Angle exaggeration of --picture and --glb."),
 ) -> None:
     """Mounting-misalignment budget: source formulas, worst case and Monte Carlo."""
-    from align.io import files as fileio
+    import align.io as fileio
     from align.errors import InputError
     from align.present.text import budget_summary
     from mechanics.budget import budget as make_budget
@@ -293,7 +293,7 @@ def allowable(
     symbolic: Optional[str] = typer.Option(None, help="Also print the sympy response and sensitivity: pretty | latex."),
 ) -> None:
     """Allowable misalignment per element for a manoeuvre, the binding element and the cone."""
-    from align.io import files as fileio
+    import align.io as fileio
     from align.sensitivity.allowable import allowable as compute, manoeuvre_from_dict, symbolic_text
     from align.present.text import allowable_summary
 
@@ -315,7 +315,7 @@ def check(
 ) -> None:
     """The mounting budget against the allowance; exit status 4 when an element fails."""
     from align import CONVENTION
-    from align.io import files as fileio
+    import align.io as fileio
     from align.errors import InputError
     from align.sensitivity.allowable import allowable as compute, manoeuvre_from_dict, margins
     from align.present.text import margin_summary
@@ -362,7 +362,7 @@ def allan(
 ) -> None:
     """Allan deviation, noise-model fit and noise figures of static recordings."""
 
-    from align.io import files as fileio
+    import align.io as fileio
     from align.errors import InputError
     from align.noise.job import allan_plot_png, run_allan
     from align.present.text import allan_summary
@@ -442,7 +442,7 @@ def plan(
     """Averaging time per table step for an alignment goal (Example 3), and the whole plan."""
     import numpy as np
 
-    from align.io import files as fileio
+    import align.io as fileio
     from align.errors import InputError
     from align.noise.planner import make_plan, model_curve
     from align.present.text import plan_summary
@@ -505,7 +505,7 @@ def report(
     seed: int = typer.Option(0, help="Monte Carlo seed."),
 ) -> None:
     """One self-contained HTML report: budget, allowance, noise plan and alignment."""
-    from align.io import files as fileio
+    import align.io as fileio
     from align.errors import InputError
     from align.present.story import build_report
 
@@ -524,7 +524,7 @@ def demo(
 ) -> None:
     """The whole story on bundled inputs (Examples 1-3, simulated records): summary and report."""
 
-    from align.io import files as fileio
+    import align.io as fileio
     from align.present.story import build_report, demo_inputs
 
     out.mkdir(parents=True, exist_ok=True)
@@ -576,7 +576,7 @@ def calibrate_ferraris(
 ) -> None:
     """A Ferraris session (six static faces and a turn about each axis), as imucal records it."""
 
-    from align.io import files as fileio
+    import align.io as fileio
     from align.calibration.accel import ferraris, imucal_dict
     from align.errors import InputError
     from align.present.text import calibration_summary
@@ -622,9 +622,9 @@ def calibrate_accel_cmd(
     """Accelerometer multi-position calibration (known orientations, or |a| = g over many attitudes)."""
     import numpy as np
 
-    from align.io import files as fileio
+    import align.io as fileio
     from align.calibration.accel import accel_session
-    from align.alignment.checks import check_log
+    from align.io import check_log
     from align.alignment.segment import static_intervals
     from align.present.text import calibration_summary
     from align.units import parse_unit
@@ -660,7 +660,7 @@ def calibrate_mag(
     """Magnetometer hard and soft iron (ellipsoid fit with coverage gates)."""
     import numpy as np
 
-    from align.io import files as fileio
+    import align.io as fileio
     from align.errors import InputError
     from align.calibration.magnetometer import alignment_to_gravity, calibrate_magnetometer
     from align.present.text import magnetometer_summary

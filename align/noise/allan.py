@@ -76,7 +76,7 @@ def _get_kernels():
 
 
 class ArrayChunks:
-    """Row chunks of an in-memory (n, C) array, with the interface of :class:`align.fileio.NpyChunks`."""
+    """Row chunks of an in-memory (n, C) array, with the interface of :class:`align.io.NpyChunks`."""
 
     def __init__(self, data) -> None:
         arr = np.asarray(data)
@@ -240,7 +240,7 @@ def allan(data, fs: float, names=None, grid="dense", per_decade: int = 10, modif
     ----------
     data : array_like, shape (n,) or (n, C), or a chunk source
         Rate samples, uniform in time; an in-memory array or an object with
-        ``shape`` and ``chunks(rows, columns)`` such as :class:`align.fileio.NpyChunks`
+        ``shape`` and ``chunks(rows, columns)`` such as :class:`align.io.NpyChunks`
         (read twice per channel, never whole).
     fs : float
         Sample rate, Hz.

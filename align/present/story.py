@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from align.io import files as fileio
+from align.io import read_log, read_static, read_toml, write_bytes, write_csv, write_text
 from align.units import DEG, DEG_H, parse_quantity as q
 
 DEMO = Path(__file__).with_name("demo")
@@ -32,14 +32,14 @@ def demo_inputs(out: Path, seed: int = 0) -> dict:
     from align.units import to_unit
 
     mount, manoeuvre = out / "mount.toml", out / "manoeuvre.toml"
-    fileio.write_text(mount, (DEMO / "mount.toml").read_text())
-    fileio.write_text(manoeuvre, (DEMO / "manoeuvre.toml").read_text())
+    write_text(mount, (DEMO / "mount.toml").read_text())
+    write_text(manoeuvre, (DEMO / "manoeuvre.toml").read_text())
     rng = np.random.default_rng(seed)
     # a static record with the ADIS16485's datasheet noise (0.3 deg/sqrt(h), 6.25 deg/h), 20 min at 100 Hz
     static = simulate_noise(120_000, 100.0, NoiseSpec(white=q("0.3 deg/sqrt(h)", "angle_random_walk"),
                                                        flicker=q("6.25 deg/h", "angular_rate")), 3, rng)
     static_path = out / "static.npy"
-    fileio.write_bytes(static_path, _npy(to_unit(static, "deg/s")))
+    write_bytes(static_path, _npy(to_unit(static, "deg/s")))
     # a +/-100 deg/s six-dwell session of an IMU mounted 0.8 deg off, known truth
     plan = Plan.standard_rate(100 * DEG)
     from scipy.spatial.transform import Rotation
@@ -50,8 +50,8 @@ def demo_inputs(out: Path, seed: int = 0) -> dict:
     t, g, _ = simulate_session(plan, truth, SessionSpec(fs=200.0, dwell_s=8.0, static_s=2.0,
                                                         noise_density=q("0.3 deg/sqrt(h)", "angle_random_walk")), rng)
     log, plan_path = out / "session.csv", out / "plan.toml"
-    fileio.write_csv(log, ["time", "gyro_x", "gyro_y", "gyro_z"], np.column_stack([t, to_unit(g, "deg/s")]))
-    fileio.write_text(plan_path, plan.to_toml())
+    write_csv(log, ["time", "gyro_x", "gyro_y", "gyro_z"], np.column_stack([t, to_unit(g, "deg/s")]))
+    write_text(plan_path, plan.to_toml())
     return {"mount": mount, "manoeuvre": manoeuvre, "log": log, "plan": plan_path, "allan": static_path,
             "allan_rate_hz": 100.0, "allan_columns": "gyro_x,gyro_y,gyro_z", "truth_M": truth.M}
 
@@ -78,11 +78,11 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
     from align.sensitivity.allowable import allowable, manoeuvre_from_dict, margins
 
     inputs = {"mount": (str(mount), Path(mount).read_text()), "manoeuvre": (str(manoeuvre), Path(manoeuvre).read_text())}
-    m = mount_from_dict(fileio.read_toml(mount), str(mount), Path(mount).parent)
+    m = mount_from_dict(read_toml(mount), str(mount), Path(mount).parent)
     b = budget(m)
     if monte_carlo:
         b = type(b)(**{**b.__dict__, "monte_carlo": run_mc(m, monte_carlo, seed, progress=progress)})
-    man = manoeuvre_from_dict(fileio.read_toml(manoeuvre), str(manoeuvre), Path(manoeuvre).parent)
+    man = manoeuvre_from_dict(read_toml(manoeuvre), str(manoeuvre), Path(manoeuvre).parent)
     allow = allowable(man)
     rows = margins(b.elements(basis), allow)
     sections = [report.budget_section(b, histogram_png(b) if monte_carlo else None, assembly_png(m)),
@@ -99,7 +99,7 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
         from align.noise.planner import make_plan
 
         names = [c.strip() for c in allan_columns.split(",")]
-        data, fs = fileio.read_static(allan, names, allan_rate_hz)
+        data, fs = read_static(allan, names, allan_rate_hz)
         job = run_allan([data], fs, names, allan_units)
         job = type(job)(**{**job.__dict__, "inputs": [str(allan)]})
         allan_dict = job.to_dict()
@@ -117,8 +117,8 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
         from align.alignment.job import align
         from align.alignment.plan import Plan
 
-        the_plan = Plan.from_dict(fileio.read_toml(plan), str(plan))
-        t, g = fileio.read_log(log, ["gyro_x", "gyro_y", "gyro_z"], gyro_units)
+        the_plan = Plan.from_dict(read_toml(plan), str(plan))
+        t, g = read_log(log, ["gyro_x", "gyro_y", "gyro_z"], gyro_units)
         r = align(t, g, the_plan, units=gyro_units, where=str(log))
         sections.append(report.alignment_section(r))
         inputs["rate-table log"] = (str(log), "")

@@ -209,8 +209,8 @@ def manoeuvre_from_dict(data: dict, where: str = "manoeuvre", base_dir=None) -> 
 def _series(series: dict, limits: dict, where: str, base_dir) -> Manoeuvre:
     from pathlib import Path
 
-    from align.io import files as fileio
-    from align.alignment.checks import check_log, check_time
+    from align.io import read_log
+    from align.io import check_log, check_time
 
     if "file" not in series:
         raise InputError("missing file = \"rates.csv\"", f"{where}: series.file")
@@ -220,7 +220,7 @@ def _series(series: dict, limits: dict, where: str, base_dir) -> Manoeuvre:
     cols = [c.strip() for c in str(series.get("columns", "time,wx,wy,wz")).split(",")]
     if len(cols) != 4:
         raise InputError("columns must name time and three rates", f"{where}: series.columns")
-    t, w = fileio.read_log(path, cols[1:], str(series.get("units", "deg/s")), cols[0])
+    t, w = read_log(path, cols[1:], str(series.get("units", "deg/s")), cols[0])
     check_log(t, w, str(path), min_rows=2)
     check_time(t, str(path), gap=1.5)
     inc = 0.5 * (w[1:] + w[:-1]) * np.diff(t)[:, None]   # trapezoid increments

@@ -1,0 +1,141 @@
+"""Results: one envelope, one registry, one loader.
+
+Every result imu-align writes is a JSON object whose first keys are the
+envelope::
+
+    {"format": "imu-align.alignment", "version": 1, "generator": "imu-align 0.2.0",
+     "convention": "g = M w + b; ...", "units": {...}, ...body...}
+
+A result type is a frozen :class:`Result` dataclass that names its ``FORMAT``,
+``VERSION`` and ``CONVENTION``, writes itself with :meth:`Result.to_dict`
+(through :meth:`Result.envelope`) and reads itself back with
+:meth:`Result.from_dict` (which first calls :meth:`Result.check_envelope`).
+:func:`load_result` picks the type from the file's ``format`` and refuses an
+unknown format, a missing version or a newer one with one clear line, as
+imucal's ``load_calibration_info`` does; :func:`save_result` writes any result
+atomically. A new result type adds one line to :data:`KNOWN`.
+
+Public names
+------------
+Result, KNOWN, register, envelope, load_result, result_from_dict, save_result
+"""
+
+from __future__ import annotations
+
+import importlib
+from pathlib import Path
+from typing import Any, ClassVar
+
+from align import __version__
+from align.errors import InputError
+from align.io.files import read_json, write_json
+from align.values import Value
+
+#: every result format -> the module that defines (and registers) its type
+KNOWN: dict[str, str] = {
+    "imu-align.alignment": "align.alignment.job",
+    "imu-align.calibration": "align.calibration.results",
+    "imu-align.magnetometer": "align.calibration.magnetometer",
+    "imu-align.allan": "align.noise.job",
+    "imu-align.plan": "align.noise.planner",
+    "imu-align.allowable": "align.sensitivity.allowable",
+    "imu-align.check": "align.sensitivity.allowable",
+    "imu-align.budget": "mechanics.budget",
+}
+
+_TYPES: dict[str, type[Result]] = {}
+
+
+def register(cls: type[Result]) -> type[Result]:
+    """Class decorator: make ``cls`` the type :func:`load_result` returns for ``cls.FORMAT``."""
+    if cls.FORMAT not in KNOWN:
+        raise ValueError(f"{cls.FORMAT} is not listed in align.results.KNOWN")
+    _TYPES[cls.FORMAT] = cls
+    return cls
+
+
+def envelope(format: str, version: int, convention: str, units: dict[str, str] | None = None) -> dict[str, Any]:
+    """The first keys of every result file: format, version, generator, convention, units."""
+    return {"format": format, "version": version, "generator": f"imu-align {__version__}",
+            "convention": convention, "units": dict(units or {})}
+
+
+class Result(Value):
+    """Base of every result type (a frozen dataclass, see :class:`~align.values.Value`).
+
+    Subclasses set ``FORMAT``, ``VERSION`` and ``CONVENTION`` and implement
+    ``to_dict`` (calling :meth:`envelope`) and ``from_dict`` (calling
+    :meth:`check_envelope`); ``from_dict(to_dict(r)) == r``.
+    """
+
+    FORMAT: ClassVar[str]
+    VERSION: ClassVar[int] = 1
+    CONVENTION: ClassVar[str]
+
+    def envelope(self, units: dict[str, str] | None = None) -> dict[str, Any]:
+        """The envelope of this result (see :func:`envelope`)."""
+        return envelope(self.FORMAT, self.VERSION, self.CONVENTION, units)
+
+    @classmethod
+    def check_envelope(cls, d: Any, where: str = "result") -> None:
+        """Refuse a dictionary that is not this type's format, or a newer version of it."""
+        if not isinstance(d, dict):
+            raise InputError("expected a JSON object", where)
+        if d.get("format") != cls.FORMAT:
+            raise InputError(f"not an {cls.FORMAT} result (format {d.get('format')!r})", where)
+        version = d.get("version")
+        if not isinstance(version, int) or isinstance(version, bool) or version < 1:
+            raise InputError(f"{cls.FORMAT} result without a valid version ({version!r}); regenerate it", where)
+        if version > cls.VERSION:
+            raise InputError(f"{cls.FORMAT} version {version} is newer than this imu-align {__version__} reads "
+                             f"(up to {cls.VERSION}); upgrade imu-align", where)
+
+    def to_dict(self) -> dict[str, Any]:  # pragma: no cover - every subclass implements it
+        raise NotImplementedError
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any], where: str = "result") -> Result:  # pragma: no cover
+        raise NotImplementedError
+
+
+def _type_of(fmt: Any, where: str) -> type[Result]:
+    if fmt not in KNOWN:
+        known = ", ".join(KNOWN)
+        raise InputError(f"not an imu-align result (format {fmt!r}); expected one of: {known}", where)
+    if fmt not in _TYPES:
+        importlib.import_module(KNOWN[fmt])
+    return _TYPES[fmt]
+
+
+def result_from_dict(d: Any, where: str = "result") -> Result:
+    """The result a dictionary holds, of the type its ``format`` names."""
+    if not isinstance(d, dict):
+        raise InputError("expected a JSON object", where)
+    return _type_of(d.get("format"), where).from_dict(d, where)
+
+
+def load_result(path: str | Path, expect: tuple[type[Result], ...] | None = None) -> Result:
+    """Read any imu-align result file and return its type.
+
+    Parameters
+    ----------
+    path : str or Path
+        A JSON file written by :func:`save_result` (or any ``--json`` output).
+    expect : tuple of Result types, optional
+        Refuse a result of any other type (naming the expected ones).
+
+    Returns
+    -------
+    Result
+    """
+    d = read_json(path)
+    result = result_from_dict(d, str(path))
+    if expect is not None and not isinstance(result, expect):
+        names = " or ".join(t.FORMAT for t in expect)
+        raise InputError(f"holds an {result.FORMAT} result; expected {names}", str(path))
+    return result
+
+
+def save_result(path: str | Path, result: Result) -> None:
+    """Write a result atomically as indented JSON (NaN as null)."""
+    write_json(path, result.to_dict())

@@ -1,0 +1,88 @@
+"""Value types: frozen, compared by value, arrays read-only.
+
+Results and models are frozen dataclasses deriving from :class:`Value`. Their
+array fields are copied and made read-only when the value is built, so a value
+never changes and never shares a buffer a caller can write to; ``==`` compares
+every field by value (arrays element-wise, NaN equal to NaN), and
+:func:`approx_equal` does the same within a tolerance, as scipy's
+``Rotation.approx_equal`` does for rotations.
+
+Public names
+------------
+Value, frozen_array, approx_equal
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any
+
+import numpy as np
+
+
+def frozen_array(a, shape: tuple[int, ...] | None = None, dtype=float) -> np.ndarray:
+    """A read-only copy of ``a`` as an ndarray (reshaped when ``shape`` is given)."""
+    arr = np.array(a, dtype=dtype)
+    if shape is not None:
+        arr = arr.reshape(shape)
+    arr.flags.writeable = False
+    return arr
+
+
+def _same(a: Any, b: Any, rtol: float, atol: float) -> bool:
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        a, b = np.asarray(a), np.asarray(b)
+        if a.shape != b.shape:
+            return False
+        if a.dtype.kind in "fc" or b.dtype.kind in "fc":
+            return bool(np.allclose(a, b, rtol=rtol, atol=atol, equal_nan=True)) if (rtol or atol) else \
+                bool(np.array_equal(a, b, equal_nan=True))
+        return bool(np.array_equal(a, b))
+    if dataclasses.is_dataclass(a) and not isinstance(a, type):
+        if type(a) is not type(b):
+            return False
+        return all(_same(getattr(a, f.name), getattr(b, f.name), rtol, atol) for f in dataclasses.fields(a))
+    if isinstance(a, dict):
+        return isinstance(b, dict) and a.keys() == b.keys() and all(_same(a[k], b[k], rtol, atol) for k in a)
+    if isinstance(a, (list, tuple)):
+        return isinstance(b, (list, tuple)) and len(a) == len(b) and all(_same(x, y, rtol, atol) for x, y in zip(a, b))
+    if isinstance(a, float) or isinstance(b, float):
+        if not isinstance(b, (int, float)) or not isinstance(a, (int, float)):
+            return False
+        if math.isnan(a) or math.isnan(b):
+            return math.isnan(a) and math.isnan(b)
+        return abs(a - b) <= atol + rtol * abs(b)
+    return a == b
+
+
+def approx_equal(a: Any, b: Any, rtol: float = 1e-9, atol: float = 0.0) -> bool:
+    """True when two values (dataclasses, arrays, dicts, sequences, numbers) agree.
+
+    Floats and arrays agree when ``|a - b| <= atol + rtol |b|`` element-wise
+    (NaN agrees with NaN); everything else must be equal.
+    """
+    return _same(a, b, rtol, atol)
+
+
+class Value:
+    """Mixin for frozen dataclasses: read-only array fields and value equality.
+
+    Declare subclasses with ``@dataclass(frozen=True, eq=False)``; a subclass
+    with its own ``__post_init__`` calls ``super().__post_init__()``.
+    """
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):
+            v = getattr(self, f.name)
+            if isinstance(v, np.ndarray):
+                object.__setattr__(self, f.name, frozen_array(v, dtype=v.dtype))
+
+    def __eq__(self, other: object) -> bool:
+        return type(self) is type(other) and _same(self, other, 0.0, 0.0)
+
+    __hash__ = None  # values holding arrays are not hashable
+
+    def replace(self, **changes):
+        """A copy with some fields changed (``dataclasses.replace``)."""
+        return dataclasses.replace(self, **changes)
