@@ -9,30 +9,25 @@ Conventions shared by every module (see ``docs`` in README and the reference
 * time series are arrays of shape ``(n, 3)``; everything inside is SI
   (rad, rad/s, m, s). Units appear only at the edges (files, command line).
 
-Modules
--------
-errors     user-facing exception hierarchy
-units      parsing of unit strings ("100 deg/s", "0.3 deg/sqrt(h)")
-model      the measurement model ``SensorModel`` and its angles
-plan       the rate-table test plan (steps) and its TOML loader
-fileio     log readers and result writers (CSV, .npy, .parquet, JSON, C header)
-segment    automatic segmentation of a log into dwells, turns and static periods
-estimate   estimators of ``[M | b]`` (Eq 19-31, Eq 35-36, weighted least squares)
-checks     checks that turn a bad test into a clear error
-earth      Earth rotation rate
-simulate   rate-table session simulator
-alignment  the end-to-end alignment job and its result type
-sensitivity  what misalignment does to a manoeuvre; allowable misalignment (sympy)
-parts      datasheet presets shared by the budget and the planner
-allan      overlapping / modified Allan deviation (numba kernels in _allan_kernels)
-noisefit   five-term noise fit, IEEE readouts, the seed's noise figures
-noisesim   sensor-error simulator and the seed's error models
-planner    averaging time and test plan (Example 3)
-noisereport  the Allan job, its JSON form and plot
-calibration  accelerometer and gyro calibration (multi-position, Ferraris)
-magnetometer hard/soft-iron ellipsoid fit with gates
-summary    readable text summaries; report: the HTML report; story: demo and report job
-cli        the ``imu-align`` command line (a thin layer)
+Layout (each layer imports only the layers below it; CI checks this)
+--------------------------------------------------------------------
+foundation   errors (user-facing exceptions naming inputs, not flags), units (unit strings to
+             SI), model (``SensorModel`` and its angles), earth, parts (datasheet presets),
+             values (frozen value types compared by value)
+io           logs (every log reader and its row/time checks), files (TOML, JSON, atomic
+             writes), export (C header, imucal)
+results      the one envelope, the registry of result types, ``load_result`` / ``save_result``
+alignment    plan, segment, estimate, checks, simulate, job: ``M`` and ``A`` from a rate table
+noise        Allan deviation, noise model and fit, figures, simulator, planner, the Allan job
+sensitivity  symbolic response, attitude, manoeuvre, allowable misalignment
+calibration  accelerometer, Ferraris sessions, magnetometer, their results
+present      text summaries, the HTML report, pictures, the demo and report jobs
+cli          the ``imu-align`` command line (thin: options, units at the edge, output)
+
+``mechanics`` (the mounting budget) sits beside ``align`` and imports only its foundation,
+io and results. A new estimator goes in ``alignment/estimate.py`` (or a module beside it),
+a new file format in ``io``, a new sensor in ``calibration``, a new command in ``cli``
+with its logic in the library.
 """
 
 __version__ = "0.1.0"

@@ -17,14 +17,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from align.errors import HandednessError
+from align.values import Value, frozen_array
 
 AXES = ("x", "y", "z")
-
-
-def _frozen(a, shape) -> np.ndarray:
-    arr = np.array(a, dtype=float).reshape(shape)
-    arr.flags.writeable = False
-    return arr
 
 
 def small_rotation_matrix(alpha: float, beta: float, gamma: float) -> np.ndarray:
@@ -109,8 +104,8 @@ def check_handedness(m: np.ndarray, where: str | None = None) -> None:
         )
 
 
-@dataclass(frozen=True)
-class Angles:
+@dataclass(frozen=True, eq=False)
+class Angles(Value):
     """Angles read from ``M`` (reference section 1), all in radians.
 
     Attributes
@@ -151,8 +146,8 @@ def angles(m: np.ndarray) -> Angles:
     return Angles(scale, psi, phi, delta, rotation_vector(nearest_rotation(m).T))
 
 
-@dataclass(frozen=True)
-class SensorModel:
+@dataclass(frozen=True, eq=False)
+class SensorModel(Value):
     """The linear sensor model ``g = M w + b`` (Eq 14-15).
 
     Immutable; build it with the ``from_*`` constructors, convert with the
@@ -168,8 +163,8 @@ class SensorModel:
     bias: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "M", _frozen(self.M, (3, 3)))
-        object.__setattr__(self, "bias", _frozen(self.bias, (3,)))
+        object.__setattr__(self, "M", frozen_array(self.M, (3, 3)))
+        object.__setattr__(self, "bias", frozen_array(self.bias, (3,)))
 
     @classmethod
     def identity(cls) -> "SensorModel":

@@ -17,14 +17,16 @@ atomically. A new result type adds one line to :data:`KNOWN`.
 
 Public names
 ------------
-Result, KNOWN, register, envelope, load_result, result_from_dict, save_result
+Result, Correction, KNOWN, register, envelope, load_result, result_from_dict, save_result
 """
 
 from __future__ import annotations
 
 import importlib
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Protocol
+
+import numpy as np
 
 from align import __version__
 from align.errors import InputError
@@ -34,6 +36,7 @@ from align.values import Value
 #: every result format -> the module that defines (and registers) its type
 KNOWN: dict[str, str] = {
     "imu-align.alignment": "align.alignment.job",
+    "imu-align.truth": "align.alignment.simulate",
     "imu-align.calibration": "align.calibration.results",
     "imu-align.magnetometer": "align.calibration.magnetometer",
     "imu-align.allan": "align.noise.job",
@@ -44,6 +47,24 @@ KNOWN: dict[str, str] = {
 }
 
 _TYPES: dict[str, type[Result]] = {}
+
+
+class Correction(Protocol):
+    """What corrects a log: the sensor it is for, the unit of its readings, and the correction.
+
+    Attributes
+    ----------
+    sensor : str
+        ``"gyroscope"``, ``"accelerometer"`` or ``"magnetometer"``.
+    units : str
+        Unit of the readings in the result's file (the default unit of the log).
+    """
+
+    sensor: str
+    units: str
+
+    def correct(self, raw: np.ndarray) -> np.ndarray:
+        """Corrected readings (n, 3), SI, from raw readings (n, 3), SI."""
 
 
 def register(cls: type[Result]) -> type[Result]:
@@ -89,6 +110,16 @@ class Result(Value):
         if version > cls.VERSION:
             raise InputError(f"{cls.FORMAT} version {version} is newer than this imu-align {__version__} reads "
                              f"(up to {cls.VERSION}); upgrade imu-align", where)
+
+    def correction(self, sensor: str | None = None, where: str = "result") -> Correction:
+        """What corrects a log of ``sensor`` (the only sensor when None); results that correct nothing refuse."""
+        raise InputError(f"holds an {self.FORMAT} result, which corrects no log; give an alignment or a calibration", where)
+
+    def _only_sensor(self, held: str, sensor: str | None, where: str) -> Correction:
+        """``self`` when ``sensor`` is None or ``held`` (for results of one sensor)."""
+        if sensor is not None and sensor != held:
+            raise InputError(f"holds a {held} result, no {sensor} calibration; choose another {{sensor}}", where)
+        return self  # type: ignore[return-value]
 
     def to_dict(self) -> dict[str, Any]:  # pragma: no cover - every subclass implements it
         raise NotImplementedError

@@ -7,7 +7,7 @@ so that a length given where an angle is expected is caught.
 
 Public names
 ------------
-parse_unit, parse_quantity, to_unit, format_quantity, unit_mixup_hint, Unit, DIMENSIONS,
+parse_unit, parse_quantity, parse_scale, to_unit, format_quantity, unit_mixup_hint, Unit, DIMENSIONS, SHOWN_IN,
 DEG, DEG_S, DEG_H, ARCSEC, MM, HOUR, STANDARD_GRAVITY
 """
 
@@ -227,6 +227,38 @@ def parse_quantity(text: str | float | int, expect: str, where: str | None = Non
     return value * parse_unit(unit_text, expect, where).factor
 
 
+#: the unit readings of a dimension are shown in when they were given as a count size
+SHOWN_IN = {"magnetic_field": "uT", "angular_rate": "deg/s", "acceleration": "m/s^2"}
+
+
+def parse_scale(text: str, expect: str, where: str | None = None) -> tuple[float, str]:
+    """The unit of raw readings: a unit of ``expect``, ``counts``, or the size of one count.
+
+    Parameters
+    ----------
+    text : str
+        ``"uT"``, ``"gauss"``, ``"counts"`` (readings kept in counts), or a count size
+        such as ``"0.92 mG"`` (one count is that much).
+    expect : str
+        A key of :data:`DIMENSIONS` with an entry in :data:`SHOWN_IN`.
+    where : str, optional
+        The input concerned, for the error message.
+
+    Returns
+    -------
+    factor : float
+        Multiplies a reading into SI (or counts).
+    shown : str
+        The unit the scaled readings are shown and written in.
+    """
+    if text[:1].isdigit() or text[:1] == ".":
+        return parse_quantity(text, expect, where), SHOWN_IN[expect]
+    unit = parse_unit(text, where=where)
+    if unit.dim not in (DIMENSIONS[expect][0].dim, DIMENSIONS["counts"][0].dim):
+        raise UnitError(f"'{text}' is not {DIMENSIONS[expect][1]}, 'counts' or the size of one count", where)
+    return unit.factor, text
+
+
 def to_unit(value_si, unit: str):
     """Convert an SI value (scalar or array) to ``unit`` (inverse of parsing)."""
     return value_si / parse_unit(unit).factor
@@ -237,10 +269,10 @@ def format_quantity(value_si: float, unit: str, digits: int = 6) -> str:
     return f"{to_unit(value_si, unit):.{digits}g} {unit}"
 
 
-_MIXUPS = ((180 / math.pi, "the log looks like deg/s read as rad/s: set --gyro-units deg/s"),
-           (math.pi / 180, "the log looks like rad/s read as deg/s: set --gyro-units rad/s"),
-           (1e3, "mdps read as deg/s? set --gyro-units mdps"),
-           (1e-3, "deg/s read as mdps? check --gyro-units"))
+_MIXUPS = ((180 / math.pi, "the log looks like deg/s read as rad/s: set {gyro_units=deg/s}"),
+           (math.pi / 180, "the log looks like rad/s read as deg/s: set {gyro_units=rad/s}"),
+           (1e3, "mdps read as deg/s? set {gyro_units=mdps}"),
+           (1e-3, "deg/s read as mdps? check {gyro_units}"))
 
 
 def unit_mixup_hint(ratio: float) -> str | None:

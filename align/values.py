@@ -50,6 +50,8 @@ def _same(a: Any, b: Any, rtol: float, atol: float) -> bool:
     if isinstance(a, float) or isinstance(b, float):
         if not isinstance(b, (int, float)) or not isinstance(a, (int, float)):
             return False
+        if a == b:  # equal, infinities included (inf - inf is NaN)
+            return True
         if math.isnan(a) or math.isnan(b):
             return math.isnan(a) and math.isnan(b)
         return abs(a - b) <= atol + rtol * abs(b)

@@ -6,7 +6,7 @@ package centre, x along ``size_x``, y along ``size_y``, z up.
 
 Public names
 ------------
-Mount, mount_from_dict
+Mount, mount_from_dict, corner_ledges, DISTRIBUTIONS
 """
 
 from __future__ import annotations
@@ -18,13 +18,17 @@ import numpy as np
 
 from align.errors import InputError
 from align.parts import get_part
-from align.units import parse_quantity
+from align.units import DEG, parse_quantity
+from align.values import Value
 
+from mechanics.formulas import screw_radius
+
+#: how a tolerance is drawn in the Monte Carlo (normal: the band or bound is +/- 3 sigma)
 DISTRIBUTIONS = ("uniform", "normal")
 
 
-@dataclass(frozen=True)
-class Mount:
+@dataclass(frozen=True, eq=False)
+class Mount(Value):
     """A mount in SI units (m, rad).
 
     Attributes
@@ -68,6 +72,12 @@ class Mount:
     part: str | None = None
     baseplate: str | None = None
 
+    def __post_init__(self) -> None:
+        for name in ("axis_to_package", "package", "pad_heights"):
+            object.__setattr__(self, name, np.asarray(getattr(self, name), dtype=float).reshape(-1))
+        object.__setattr__(self, "pads", np.asarray(self.pads, dtype=float).reshape(len(self.pad_heights), -1, 2))
+        super().__post_init__()
+
     @property
     def screws(self) -> np.ndarray:
         """Nominal screw centres, shape (4, 2), m."""
@@ -78,6 +88,55 @@ class Mount:
     def clearance(self) -> float:
         """Radial clearance of a screw in its hole, m."""
         return (self.hole_diameter - self.screw_diameter) / 2.0
+
+    def to_dict(self) -> dict:
+        """The mount in file units (deg, mm): the ``mount`` of a budget result."""
+        return {
+            "part": self.part, "axis_to_package_deg": (self.axis_to_package / DEG).tolist(),
+            "package_mm": (self.package * 1e3).tolist(), "ledge_size_mm": self.ledge_size * 1e3,
+            "height_tolerance_mm": self.height_tolerance * 1e3, "screw_diameter_mm": self.screw_diameter * 1e3,
+            "hole_diameter_mm": self.hole_diameter * 1e3, "spacing_mm": [self.spacing_x * 1e3, self.spacing_y * 1e3],
+            "screw_radius_mm": screw_radius(self.spacing_x, self.spacing_y) * 1e3,
+            "position_tolerance_mm": self.position_tolerance * 1e3,
+            "extras_deg": {k: v / DEG for k, v in self.extras.items()}, "distributions": dict(self.distributions),
+            "baseplate": self.baseplate,
+            "pads_mm": (self.pads * 1e3).tolist(), "pad_heights_mm": (self.pad_heights * 1e3).tolist(),
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "mount") -> Mount:
+        """Read the form written by :meth:`to_dict` (a file without ``pads_mm`` has the corner ledges
+        of ``ledge_size_mm``)."""
+        try:
+            package = np.array(d["package_mm"], float).reshape(3) * 1e-3
+            size = float(d["ledge_size_mm"]) * 1e-3
+            if "pads_mm" in d:
+                pads, heights = np.array(d["pads_mm"], float) * 1e-3, np.array(d["pad_heights_mm"], float) * 1e-3
+            else:
+                pads, heights = corner_ledges(package[0], package[1], size), np.zeros(4)
+            spacing = [float(v) * 1e-3 for v in d["spacing_mm"]]
+            return cls(np.array(d["axis_to_package_deg"], float).reshape(3) * DEG, package, pads, heights, size,
+                       float(d["height_tolerance_mm"]) * 1e-3, float(d["screw_diameter_mm"]) * 1e-3,
+                       float(d["hole_diameter_mm"]) * 1e-3, spacing[0], spacing[1],
+                       float(d.get("position_tolerance_mm", 0.0)) * 1e-3,
+                       {k: float(v) * DEG for k, v in d.get("extras_deg", {}).items()},
+                       dict(d["distributions"]), d.get("part"), d.get("baseplate"))
+        except (KeyError, TypeError, ValueError, IndexError) as exc:
+            raise InputError(f"malformed mount ({exc!r})", where) from None
+
+
+def corner_ledges(size_x: float, size_y: float, size: float) -> np.ndarray:
+    """Outlines of four square ledges of side ``size`` in the corners of a ``size_x`` by ``size_y`` package.
+
+    Returns
+    -------
+    ndarray, shape (4, 4, 2)
+        Corner order (+x,+y), (-x,+y), (-x,-y), (+x,-y), as :data:`mechanics.rest.CORNERS`; m.
+    """
+    cx, cy, h = size_x / 2 - size / 2, size_y / 2 - size / 2, size / 2
+    square = np.array([[-h, -h], [h, -h], [h, h], [-h, h]])
+    centres = np.array([[cx, cy], [-cx, cy], [-cx, -cy], [cx, -cy]])
+    return centres[:, None, :] + square[None, :, :]
 
 
 def _table(data: dict, name: str, where: str, required: bool = True) -> dict:
@@ -157,7 +216,7 @@ def mount_from_dict(data: dict, where: str = "mount", base_dir: Path | None = No
     tol = _length(ledges, "height_tolerance", "ledges", where, default="0 mm", positive=False)
     baseplate = None
     if plate:
-        from .rest import ledges_from_stl
+        from mechanics.rest import ledges_from_stl
 
         if "stl" not in plate:
             raise InputError("missing field stl = \"FILE.stl\"", f"{where}: baseplate.stl")
@@ -172,11 +231,7 @@ def mount_from_dict(data: dict, where: str = "mount", base_dir: Path | None = No
         size = _length(ledges, "size", "ledges", where)
         if 2 * size >= min(size_x, size_y):
             raise InputError("ledges overlap: size must be under half the package size", f"{where}: ledges.size")
-        cx, cy, h = size_x / 2 - size / 2, size_y / 2 - size / 2, size / 2
-        square = np.array([[-h, -h], [h, -h], [h, h], [-h, h]])
-        centres = np.array([[cx, cy], [-cx, cy], [-cx, -cy], [cx, -cy]])
-        pads = centres[:, None, :] + square[None, :, :]
-        heights = np.zeros(4)
+        pads, heights = corner_ledges(size_x, size_y, size), np.zeros(4)
     extras_t = _table(data, "extra", where, required=False)
     extras = {}
     for name, value in extras_t.items():

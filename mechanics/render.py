@@ -16,9 +16,9 @@ import numpy as np
 
 from align.units import DEG
 
-from .budget import Budget
-from .mount import Mount
-from .rest import rest_plane_hull
+from mechanics.budget import Budget
+from mechanics.mount import Mount
+from mechanics.rest import rest_plane_hull
 
 
 def resting_pose(m: Mount, heights: np.ndarray, skew: float) -> tuple[float, float, float, float]:

@@ -45,18 +45,24 @@ class CliResult:
 
 
 @pytest.fixture
-def run_cli(capsys, monkeypatch):
-    """Run ``imu-align ARGS`` in-process; returns exit code, stdout, stderr."""
+def run_cli(capsys):
+    """Run ``imu-align ARGS`` in-process (the console script's ``main``); returns exit code, stdout, stderr."""
     from align.cli import main
 
     def run(*args) -> CliResult:
-        monkeypatch.setattr(sys, "argv", ["imu-align", *map(str, args)])
-        code = 0
+        capsys.readouterr()  # drop what came before
         try:
-            main()
+            main([str(a) for a in args])
+            code = 0
         except SystemExit as exc:
             code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
         cap = capsys.readouterr()
         return CliResult(code, cap.out, cap.err)
 
     return run
+
+
+def imu_align_command() -> list[str]:
+    """The installed ``imu-align`` console script beside this Python (``python -m align.cli`` without one)."""
+    script = Path(sys.executable).with_name("imu-align")
+    return [str(script)] if script.exists() else [sys.executable, "-m", "align.cli"]

@@ -51,7 +51,7 @@ def check_span(plan: Plan, allow_two_axis: bool = False) -> int | None:
     names = ", ".join(axis_name(a)[1] for a in sorted(turned))
     if allow_two_axis and len(missing) == 1:
         return missing[0]
-    hint = "add steps about it or use --method two-axis (assumes orthogonal gyros)" if len(missing) == 1 else "add steps about them"
+    hint = "add steps about it or set {method=two-axis} (assumes orthogonal gyros)" if len(missing) == 1 else "add steps about them"
     raise TestError(
         f"the rotations do not span 3-D: the plan turns about {names} only, never about "
         f"{', '.join(axis_name(a)[1] for a in missing)}; {hint}",
@@ -62,7 +62,7 @@ def check_span(plan: Plan, allow_two_axis: bool = False) -> int | None:
 def check_saturation(g: np.ndarray, segments: list[Segment], gyro_range: float | None, units: str) -> Check:
     """No sample used in a segment may reach 99 % of the stated gyro range."""
     if gyro_range is None:
-        return Check("saturation", "pass", "no gyro range stated (--gyro-range)")
+        return Check("saturation", "pass", "no gyro range stated ({gyro_range})")
     limit = 0.99 * gyro_range
     for seg in segments:
         peak = float(np.max(np.abs(g[seg.start : seg.end])))
@@ -83,7 +83,7 @@ def check_durations(segments: list[Segment], fs: float, min_duration: float, min
         if seg.n < min_samples or seg.n / fs < min_duration:
             raise TestError(
                 f"lasts {seg.n / fs:.3g} s ({seg.n} samples), shorter than the {min_duration:g} s minimum; "
-                "dwell longer at this step (or lower --min-dwell)",
+                "dwell longer at this step (or lower {min_dwell})",
                 seg.name,
             )
     return Check("durations", "pass", f"every step at least {min_duration:g} s")
@@ -146,7 +146,7 @@ def check_scale(m: np.ndarray, tolerance: float) -> Check:
         if not abs(s - 1.0) <= tolerance:
             raise TestError(
                 f"gyro {'xyz'[i]} scale factor {s:.4f} is outside 1 +/- {tolerance:g}: wrong gyro units, "
-                "wrong table rate, or a broken gyro (raise --scale-tolerance if this is expected)",
+                "wrong table rate, or a broken gyro (raise {scale_tolerance} if this is expected)",
                 "result",
             )
     return Check("scale", "pass", f"scale factors {', '.join(f'{s:.5f}' for s in scale)} within 1 +/- {tolerance:g}")

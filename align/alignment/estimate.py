@@ -30,12 +30,13 @@ import numpy as np
 from align.earth import vertical_rate
 from align.errors import TestError
 from align.model import nearest_rotation
+from align.values import Value
 from align.alignment.plan import Plan, axis_name
 from align.alignment.segment import Segment, integrate
 
 
-@dataclass(frozen=True)
-class Observation:
+@dataclass(frozen=True, eq=False)
+class Observation(Value):
     """One segment as a linear observation ``y = [M | b] phi`` (SI units).
 
     ``var`` is the variance of each component of ``y`` from the noise inside
@@ -49,8 +50,8 @@ class Observation:
     duration: float
 
 
-@dataclass(frozen=True)
-class Fit:
+@dataclass(frozen=True, eq=False)
+class Fit(Value):
     """Estimated ``M`` and ``b`` with their 1-sigma uncertainties.
 
     Attributes
@@ -218,7 +219,7 @@ def _pairs(obs: list[Observation], plan: Plan, kind: str) -> dict[int, tuple[Obs
     pairs = {a: (d[1], d[-1]) for a, d in found.items() if 1 in d and -1 in d}
     missing = [axis_name(a) for a in range(3) if a not in pairs]
     if missing:
-        raise TestError(f"the {kind} method needs one +{kind} and one -{kind} step about each axis; none complete about {', '.join(missing)} (use --method lsq)")
+        raise TestError(f"the {kind} method needs one +{kind} and one -{kind} step about each axis; none complete about {', '.join(missing)} (set {{method=lsq}})")
     return pairs
 
 

@@ -23,9 +23,9 @@ from align.earth import EARTH_RATE, vertical_rate
 from align.errors import InputError
 from align.alignment.estimate import (alignment_sigma, fit_angle_pairs, fit_lsq, fit_rate_pairs, observe,
                        two_axis, two_axis_error_bound)
-from align.model import angles, check_handedness
+from align.model import Angles, SensorModel, angles, check_handedness
 from align.alignment.plan import Plan
-from align.io import check_log
+from align.io import c_header, check_log
 from align.alignment.segment import Segment, SegmentOptions, noise_sigma, segment_log
 from align.results import Result, register
 from align.units import DEG, DEG_H, parse_unit, to_unit
@@ -117,8 +117,31 @@ class AlignmentResult(Result):
     CONVENTION: ClassVar[str] = CONVENTION
 
     @property
-    def angles(self):
+    def angles(self) -> Angles:
+        """Scale factors and misalignment angles read from ``M`` (reference section 1)."""
         return angles(self.M)
+
+    @property
+    def model(self) -> SensorModel:
+        """The measurement model ``g = M w + b`` this result estimated."""
+        return SensorModel(self.M, self.bias)
+
+    @property
+    def sensor(self) -> str:
+        """The sensor this result corrects: always ``"gyroscope"``."""
+        return "gyroscope"
+
+    def correct(self, g: np.ndarray) -> np.ndarray:
+        """Aligned rates ``w = A (g - b)`` (Eq 15) for readings of shape (3,) or (n, 3), rad/s."""
+        return self.model.correct(g)
+
+    def correction(self, sensor: str | None = None, where: str = "result") -> AlignmentResult:
+        """This result, which corrects gyro logs (see :class:`align.results.Correction`)."""
+        return self._only_sensor("gyroscope", sensor, where)
+
+    def as_c_header(self, comment: str, name: str = "IMU_ALIGN") -> str:
+        """A C header with ``A`` and the bias (in :attr:`units`) for ``w = A (g - b)`` in firmware."""
+        return c_header(name, self.A, to_unit(self.bias, self.units), self.units, f"{comment}\n{CONVENTION}")
 
     def to_dict(self) -> dict:
         """The versioned JSON form; rates in ``self.units``, angles in deg."""
@@ -210,7 +233,7 @@ def _measured_turns(obs, plan: Plan, bias: np.ndarray):
 
 def _choose(method: str, plan: Plan, missing: int | None) -> str:
     if method not in METHODS:
-        raise InputError(f"unknown method '{method}'; choose one of {', '.join(METHODS)}", "--method")
+        raise InputError(f"unknown method '{method}'; choose one of {', '.join(METHODS)}", "{method}")
     if method == "auto":
         return "two-axis" if missing is not None else "lsq"
     return method
@@ -255,7 +278,7 @@ def align(
     missing = check_span(plan, allow_two_axis=options.method in ("auto", "two-axis"))
     method = _choose(options.method, plan, missing)
     if method == "two-axis" and missing is None:
-        raise InputError("--method two-axis needs a plan that turns about exactly two axes", "--method")
+        raise InputError("the two-axis method needs a plan that turns about exactly two axes", "{method}")
     fs = 1.0 / float(np.median(np.diff(t)))
     sigma = noise_sigma(g)
     if segments is None:

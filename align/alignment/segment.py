@@ -193,7 +193,7 @@ def segment_log(
         message lists what was found and where.
     """
     if plan.kind == "mixed":
-        raise InputError("the plan mixes rate and angle steps; automatic segmentation needs one kind (or give --segments)", where)
+        raise InputError("the plan mixes rate and angle steps; automatic segmentation needs one kind (or give {segments})", where)
     fs = 1.0 / float(np.median(np.diff(t)))
     runs = find_plateaus(g, fs, opts, noise_sigma(g) if sigma is None else sigma)
     if plan.kind == "rate":
@@ -210,7 +210,7 @@ def segment_log(
                 raise TestError(hint, where)
             raise TestError(
                 f"found {len(moving)} constant-rate dwells but the plan has {len(plan.steps)} steps; "
-                f"dwells found: {_describe(g, t, moving) or 'none'}; check the plan, --window/--min-dwell, or give --segments",
+                f"dwells found: {_describe(g, t, moving) or 'none'}; check the plan, {{window}}/{{min_dwell}}, or give {{segments}}",
                 where,
             )
         segs = [Segment(f"step {k + 1} ({s.label})", "rate", a, b, k) for k, (s, (a, b)) in enumerate(zip(plan.steps, moving))]
@@ -229,7 +229,7 @@ def segment_log(
             raise TestError(
                 f"found {len(turns)} turns between static periods but the plan has {len(plan.steps)} steps "
                 f"(turns found: {found}; static periods: {len(statics)}); each turn must start and end at rest "
-                "(check --static-threshold, or give --segments)",
+                "(check {static_threshold}, or give {segments})",
                 where,
             )
         segs = [Segment(f"step {k + 1} ({s.label})", "angle", a, b, k) for k, (s, (a, b)) in enumerate(zip(plan.steps, turns))]

@@ -9,19 +9,23 @@ error and saturation at a stated range.
 
 Public names
 ------------
-SessionSpec, simulate_session
+SessionSpec, simulate_session, random_model, SimulationTruth
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
-from align.earth import earth_rate_in_frame
-from align.model import SensorModel
+from align import CONVENTION
 from align.alignment.plan import Plan
-from align.units import DEG, DEG_S
+from align.earth import earth_rate_in_frame
+from align.errors import InputError
+from align.model import SensorModel
+from align.results import Result, register
+from align.units import DEG, DEG_S, parse_unit, to_unit
 
 
 @dataclass(frozen=True)
@@ -141,3 +145,61 @@ def simulate_session(plan: Plan, model: SensorModel, spec: SessionSpec = Session
     if spec.gyro_range is not None:
         g = np.clip(g, -spec.gyro_range, spec.gyro_range)
     return np.arange(n) * dt, g, w
+
+
+def random_model(rng: np.random.Generator, misalignment: float, scale_sd: float = 2e-3, delta_sd: float = 0.05 * DEG,
+                 bias_sd: float = 0.2 * DEG) -> SensorModel:
+    """A realistic random gyro model: a mounting rotation of size ``misalignment`` (rad) about a
+    random axis, scale errors, non-orthogonality and a turn-on bias.
+
+    ``M = diag(scale) N R^T`` (see :meth:`SensorModel.from_rotation`); ``scale ~ 1 + N(0, scale_sd)``,
+    ``delta ~ N(0, delta_sd)`` rad, ``bias ~ N(0, bias_sd)`` rad/s.
+    """
+    from scipy.spatial.transform import Rotation
+
+    rotvec = rng.normal(size=3)
+    rotvec *= misalignment / np.linalg.norm(rotvec)
+    return SensorModel.from_rotation(Rotation.from_rotvec(rotvec), scale=1 + rng.normal(0, scale_sd, 3),
+                                     delta=rng.normal(0, delta_sd, 3), bias=rng.normal(0, bias_sd, 3))
+
+
+@register
+@dataclass(frozen=True, eq=False)
+class SimulationTruth(Result):
+    """The true model of a simulated session (``truth.json``), to compare an alignment with.
+
+    Attributes
+    ----------
+    model : SensorModel
+        ``g = M w + b``, bias in rad/s.
+    units : str
+        File unit of the bias.
+    seed : int or None
+        The simulation's random seed.
+    inputs : dict
+    """
+
+    FORMAT: ClassVar[str] = "imu-align.truth"
+    VERSION: ClassVar[int] = 1
+    CONVENTION: ClassVar[str] = CONVENTION
+
+    model: SensorModel
+    units: str = "deg/s"
+    seed: int | None = None
+    inputs: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        return {**self.envelope({"M": "1", "bias": self.units}), "M": self.model.M.tolist(),
+                "A": self.model.alignment().tolist(), "bias": to_unit(self.model.bias, self.units).tolist(),
+                "seed": self.seed, "inputs": self.inputs}
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "truth") -> SimulationTruth:
+        cls.check_envelope(d, where)
+        try:
+            u = d["units"]["bias"]
+            f = parse_unit(u, "angular_rate", f"{where}: units.bias").factor
+            return cls(SensorModel(np.array(d["M"], float), np.array(d["bias"], float) * f), u, d.get("seed"),
+                       dict(d.get("inputs", {})))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise InputError(f"malformed simulation truth ({exc!r})", where) from None

@@ -1,1 +1,39 @@
-"""TODO"""
+"""Sensor calibration: accelerometers, gyros (Ferraris sessions) and magnetometers.
+
+Every sensor but the magnetometer shares the alignment convention
+``raw = M true + bias``; the magnetometer's is ``m_cal = soft_iron (m_raw - hard_iron)``.
+
+Modules
+-------
+results       Calibration (one sensor's ``[M | b]``) and CalibrationSet (the ``imu-align.calibration`` file)
+accel         accelerometer: multi-position least squares, the ``|a| = g`` fit, sessions from a log
+ferraris      Ferraris sessions (six faces and three turns, as imucal records them): accelerometer and gyro
+ellipsoid     algebraic ellipsoid fits and the soft-iron parametrisation
+magnetometer  MagCalibration (the ``imu-align.magnetometer`` file): hard and soft iron with gates,
+              rotation to the accelerometer frame from gravity
+
+Public names
+------------
+Calibration, CalibrationSet, SENSORS, FACES, face_ups, static_means, accel_session, calibrate_accel_log,
+StaticDetector, calibrate_accel,
+calibrate_accel_free, ferraris, sections_from_dict, SECTIONS, MagCalibration, calibrate_magnetometer, with_gravity_alignment,
+alignment_to_gravity, misalignment_from_axes_down, MODELS
+"""
+
+from align.calibration.accel import (FACES, StaticDetector, accel_session, calibrate_accel, calibrate_accel_free,
+                                     calibrate_accel_log, face_ups, static_means)
+from align.calibration.ellipsoid import MODELS
+from align.calibration.ferraris import SECTIONS, ferraris, sections_from_dict
+from align.calibration.magnetometer import (
+                                     MagCalibration,
+                                     alignment_to_gravity,
+                                     calibrate_magnetometer,
+                                     misalignment_from_axes_down,
+                                     with_gravity_alignment,
+)
+from align.calibration.results import SENSORS, Calibration, CalibrationSet
+
+__all__ = ["Calibration", "CalibrationSet", "SENSORS", "FACES", "face_ups", "static_means", "accel_session", "calibrate_accel_log", "StaticDetector",
+           "calibrate_accel", "calibrate_accel_free", "ferraris", "sections_from_dict", "SECTIONS", "MagCalibration",
+           "calibrate_magnetometer", "with_gravity_alignment", "alignment_to_gravity",
+           "misalignment_from_axes_down", "MODELS"]

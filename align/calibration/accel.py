@@ -1,97 +1,50 @@
-"""Discrete calibration of accelerometers and gyros (reference section 5; seeds 000 and 004).
+"""Accelerometer calibration from static positions (reference section 5; seeds 000 and 004).
 
-Every sensor shares the alignment convention: ``raw = M true + bias``, corrected
-by ``true = M^-1 (raw - bias)``. The gyro may also carry a g-sensitivity
-``K_ga`` (``raw = M w + K_ga a + bias``).
+The accelerometer shares the alignment convention ``raw = M true + bias``
+(:class:`~align.calibration.results.Calibration`).
 
-* Accelerometer, known orientations: ordinary least squares for ``[M | b]``
-  (12 parameters, ``K = Y X^T (X X^T)^-1`` with ``X_k = [g u_k; 1]``), 1-sigma
-  from the residuals, positions held out as a check (seed 004's 45-degree
-  positions); optionally the Ferraris pairwise bias ``b_i = (a_i(+i up) + a_i(-i up)) / 2``.
-* Accelerometer, unknown orientations (imu_tk style): ``|U (a_k - b)| = g`` over
-  many static attitudes, ``U`` upper triangular (the sensor-to-case rotation is
-  not observable), ``M = U^-1``.
-* Gyro, turns of known angle: the alignment module's estimators and checks on
-  static sections (bias) and integrated turns (Eq 31), after removing the
-  g-sensitivity estimated from the static faces (as Ferraris / imucal do).
+* Known orientations: ordinary least squares for ``[M | b]`` (12 parameters,
+  ``K = Y X^T (X X^T)^-1`` with ``X_k = [g u_k; 1]``), 1-sigma from the
+  residuals, positions held out as a check (seed 004's 45-degree positions);
+  optionally the Ferraris pairwise bias ``b_i = (a_i(+i up) + a_i(-i up)) / 2``.
+* Unknown orientations (imu_tk style): ``|U (a_k - b)| = g`` over many static
+  attitudes, ``U`` upper triangular (the sensor-to-case rotation is not
+  observable), ``M = U^-1``.
+* A session (:func:`accel_session`): the static means of a log's positions,
+  then one of the two fits.
 
 Public names
 ------------
-Calibration, static_means, accel_session, calibrate_accel, calibrate_accel_free, ferraris, FACES, imucal_dict
+FACES, face_ups, static_means, accel_session, calibrate_accel_log, StaticDetector, calibrate_accel, calibrate_accel_free
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from align import __version__
-from align.errors import InputError, TestError
 from align.alignment.estimate import Observation, fit_lsq
-from align.alignment.segment import Segment
-from align.units import STANDARD_GRAVITY, to_unit
+from align.alignment.plan import parse_axis
+from align.alignment.segment import Segment, static_intervals
+from align.calibration.results import Calibration
+from align.errors import InputError, TestError
+from align.io import check_log
+from align.units import STANDARD_GRAVITY, parse_quantity
 
-FORMAT = "imu-align.calibration"
-CONVENTION = "raw = M true + bias; true = M^-1 (raw - bias); rows of M are sensor axes"
 #: imucal's section names -> the axis pointing up (the accelerometer reads +g on it)
 FACES = {"x_p": (0, 1), "x_a": (0, -1), "y_p": (1, 1), "y_a": (1, -1), "z_p": (2, 1), "z_a": (2, -1)}
 
 
-@dataclass(frozen=True)
-class Calibration:
-    """One sensor's calibration (SI inside; ``units`` is the file/display unit of readings)."""
+def _axis_up(axis: int, sign: int) -> np.ndarray:
+    u = np.zeros(3)
+    u[axis] = sign
+    return u
 
-    sensor: str
-    M: np.ndarray
-    bias: np.ndarray
-    sigma_M: np.ndarray
-    sigma_bias: np.ndarray
-    units: str
-    method: str
-    residuals: dict = field(default_factory=dict)
-    checks: dict = field(default_factory=dict)
-    notes: tuple = ()
-    g_sensitivity: np.ndarray | None = None
 
-    def to_dict(self) -> dict:
-        u = self.units
-        d = {
-            "sensor": self.sensor, "method": self.method, "convention": CONVENTION,
-            "units": {"M": "1", "bias": u, "residuals": u},
-            "M": self.M.tolist(), "A": np.linalg.inv(self.M).tolist(),
-            "bias": to_unit(self.bias, u).tolist(),
-            "uncertainty": {"level": "1 sigma", "M": self.sigma_M.tolist(), "bias": to_unit(self.sigma_bias, u).tolist()},
-            "residuals": {k: to_unit(np.asarray(v), u).tolist() for k, v in self.residuals.items()},
-            "checks": {k: to_unit(np.asarray(v), u).tolist() for k, v in self.checks.items()},
-            "notes": list(self.notes),
-        }
-        if self.g_sensitivity is not None:
-            d["g_sensitivity"] = (self.g_sensitivity * to_unit(1.0, u)).tolist()
-            d["units"]["g_sensitivity"] = f"{u} per m/s^2"
-        return d
-
-    @classmethod
-    def from_dict(cls, d: dict, where: str = "calibration") -> "Calibration":
-        from align.units import parse_unit
-
-        try:
-            u = d["units"]["bias"]
-            f = parse_unit(u, where=f"{where}: units.bias").factor
-            unc = d.get("uncertainty", {})
-            gs = d.get("g_sensitivity")
-            return cls(d["sensor"], np.array(d["M"], float).reshape(3, 3), np.array(d["bias"], float) * f,
-                       np.array(unc.get("M", np.full((3, 3), np.nan)), float), np.array(unc.get("bias", [np.nan] * 3), float) * f,
-                       u, d.get("method", ""), {k: np.array(v) * f for k, v in d.get("residuals", {}).items()},
-                       {k: np.array(v) * f for k, v in d.get("checks", {}).items()}, tuple(d.get("notes", [])),
-                       None if gs is None else np.array(gs, float) * f)
-        except (KeyError, TypeError, ValueError) as exc:
-            raise InputError(f"malformed calibration ({exc!r})", where) from None
-
-    def correct(self, raw: np.ndarray, acc: np.ndarray | None = None) -> np.ndarray:
-        """``true = M^-1 (raw - bias - K_ga acc)`` for readings (n, 3), SI."""
-        off = self.bias if self.g_sensitivity is None or acc is None else self.bias + acc @ self.g_sensitivity.T
-        return np.linalg.solve(self.M, (np.asarray(raw) - off).T).T
+def face_ups() -> dict:
+    """imucal's six faces -> the unit vector (sensor frame) pointing up on each, shape (3,)."""
+    return {f: _axis_up(axis, sign) for f, (axis, sign) in FACES.items()}
 
 
 def _obs(name: str, mean: np.ndarray, var: np.ndarray, phi: np.ndarray) -> Observation:
@@ -104,6 +57,22 @@ def static_means(x: np.ndarray, ranges: dict, max_spread: float, where: str = ""
 
     A range is static when every axis varies by at most ``max_spread`` times the
     median magnitude of the readings (1 sigma): unit-free, so raw counts work too.
+
+    Parameters
+    ----------
+    x : ndarray, shape (n, 3)
+        Readings (any unit).
+    ranges : dict of str -> (int, int)
+        Name -> sample range ``start, end`` (end exclusive).
+    max_spread : float
+        Largest 1-sigma spread of a static range, as a fraction of the median ``|x|``.
+    where : str
+        Prefix of the ``where`` of an out-of-range error (a file name and ``": "``).
+
+    Returns
+    -------
+    dict of str -> ndarray, shape (3,)
+        The mean reading of each range.
     """
     limit = max_spread * float(np.median(np.linalg.norm(x, axis=1)))
     out = {}
@@ -120,6 +89,44 @@ def static_means(x: np.ndarray, ranges: dict, max_spread: float, where: str = ""
     return out
 
 
+@dataclass(frozen=True)
+class StaticDetector:
+    """Settings of the static-interval detector (imu_tk's moving variance, see
+    :func:`align.alignment.segment.static_intervals`): window (s), threshold factor,
+    initial static period (s, or None) and shortest interval (s)."""
+
+    window_s: float = 1.0
+    factor: float = 6.0
+    init_static_s: float | None = None
+    min_static_s: float = 1.0
+
+
+def calibrate_accel_log(t: np.ndarray, a: np.ndarray, spec: dict | None, units: str, gravity: float | None = None,
+                        detector: StaticDetector = StaticDetector(), where: str = "log",
+                        positions_file: str = "positions") -> Calibration:
+    """An accelerometer session from its log: static intervals detected, then :func:`accel_session`.
+
+    Parameters
+    ----------
+    t, a : ndarray, shapes (n,) and (n, 3)
+        Time (s) and readings, SI or counts.
+    spec : dict or None
+        The positions file (``gravity`` and ``[[position]]`` tables), or None for the ``|a| = g`` fit.
+    units : str
+        Unit of the readings.
+    gravity : float, optional
+        Local gravity (m/s^2); default the positions file's, else 9.80665.
+    detector : StaticDetector
+    """
+    check_log(t, a, where)
+    spec = spec or {}
+    if gravity is None:
+        gravity = parse_quantity(spec.get("gravity", f"{STANDARD_GRAVITY} m/s^2"), "acceleration", f"{positions_file}: gravity")
+    fs = 1.0 / float(np.median(np.diff(t)))
+    intervals = static_intervals(a, fs, detector.window_s, detector.factor, detector.init_static_s, detector.min_static_s)
+    return accel_session(t, a, intervals, spec.get("position"), gravity, units, where, positions_file)
+
+
 def accel_session(t: np.ndarray, a: np.ndarray, intervals: list, positions: list | None, gravity: float,
                   units: str, where: str = "log", positions_file: str = "positions") -> Calibration:
     """An accelerometer session: known positions (``[[position]]`` tables) or, without them, ``|a| = g``.
@@ -129,18 +136,27 @@ def accel_session(t: np.ndarray, a: np.ndarray, intervals: list, positions: list
     t, a : ndarray
         Time (s) and readings (n, 3), SI or counts.
     intervals : list of (start, end)
-        Static intervals found by :func:`align.segment.static_intervals`, used
-        when the positions give no ``start``/``end`` (matched in order) and for the free fit.
+        Static intervals found by :func:`align.alignment.segment.static_intervals`,
+        used when the positions give no ``start``/``end`` (matched in order) and
+        for the free fit.
     positions : list of dict or None
         Each with ``up`` (``"+x"`` or ``[x, y, z]``), optional ``name``, ``start``, ``end``, ``holdout``.
-    """
-    from align.alignment.plan import parse_axis
+    gravity : float
+        Local gravity, m/s^2.
+    units : str
+        Unit of the readings, for the result's file form.
+    where, positions_file : str
+        Names of the log and of the positions file, for errors.
 
+    Returns
+    -------
+    Calibration
+    """
     if positions is None:
         means = static_means(a, {f"interval {k + 1}": r for k, r in enumerate(intervals)}, 0.02, f"{where}: ")
         cal = calibrate_accel_free(np.array(list(means.values())), gravity, units)
         note = f"{len(intervals)} static intervals detected automatically (moving variance)"
-        return Calibration(**{**cal.__dict__, "notes": cal.notes + (note,)})
+        return cal.replace(notes=cal.notes + (note,))
     if not isinstance(positions, list) or not positions:
         raise InputError("no [[position]] tables", positions_file)
     if all("start" in p for p in positions):
@@ -151,16 +167,14 @@ def accel_session(t: np.ndarray, a: np.ndarray, intervals: list, positions: list
         if len(intervals) != len(positions):
             found = "; ".join(f"t={t[s]:.1f}-{t[e - 1]:.1f} s" for s, e in intervals[:20])
             raise TestError(f"{len(intervals)} static intervals detected but {len(positions)} positions listed ({found}); "
-                            "adjust --factor/--window or give start/end per position", where)
+                            "adjust the static detector ({factor}, {window_s}) or give start/end per position", where)
         ranges = intervals
     names, ups, hold = [], {}, []
     for k, p in enumerate(positions, start=1):
         name = str(p.get("name", f"position {k}"))
         up = p.get("up")
         if isinstance(up, str):
-            axis, sign = parse_axis(up, f"{positions_file}: {name}.up")
-            u = np.zeros(3)
-            u[axis] = sign
+            u = _axis_up(*parse_axis(up, f"{positions_file}: {name}.up"))
         elif isinstance(up, list) and len(up) == 3:
             u = np.asarray(up, float) / np.linalg.norm(up)
         else:
@@ -169,7 +183,7 @@ def accel_session(t: np.ndarray, a: np.ndarray, intervals: list, positions: list
         ups[name] = u
         if p.get("holdout"):
             hold.append(name)
-    means = static_means(a, dict(zip(names, ranges)), 0.02, f"{positions_file}: ")
+    means = static_means(a, dict(zip(names, ranges, strict=True)), 0.02, f"{positions_file}: ")
     return calibrate_accel(means, ups, gravity, units, tuple(hold))
 
 
@@ -186,12 +200,20 @@ def calibrate_accel(means: dict, ups: dict, gravity: float = STANDARD_GRAVITY, u
         true specific force is ``g u``.
     gravity : float
         Local gravity, m/s^2 (default standard gravity).
+    units : str
+        Unit of the readings, for the result's file form.
     holdout : tuple of str
         Positions left out of the fit and used as a check (their residuals are reported).
     pairwise_bias : bool
         Replace the least-squares bias by the Ferraris pairwise bias (needs the six faces).
     noise : dict, optional
-        Position name -> per-sample sigma (3,), reported beside the residuals.
+        Position name -> per-sample sigma (3,); accepted but not used yet.
+
+    Returns
+    -------
+    Calibration
+        ``M`` (3, 3), ``bias`` (3,) SI, with residuals per fitted position and
+        a check per held-out one.
     """
     fit_names = [k for k in means if k not in holdout]
     if len(fit_names) < 6:
@@ -224,6 +246,24 @@ def calibrate_accel_free(means: np.ndarray, gravity: float = STANDARD_GRAVITY, u
     plane: the rotation to the case is not observable), ``M = U^-1``. Solved by
     Levenberg-Marquardt (scipy) from a sphere guess; the 1-sigma come from the
     Jacobian and the residual variance.
+
+    Parameters
+    ----------
+    means : ndarray, shape (k, 3)
+        Mean reading of each static attitude, SI or counts; ``k >= 9``.
+    gravity : float
+        Local gravity, m/s^2.
+    units : str
+        Unit of the readings, for the result's file form.
+    guess_scale : float, optional
+        Starting scale (readings per m/s^2); default from the spread of ``means``.
+    guess_bias : array_like, shape (3,), optional
+        Starting bias; default the mean of ``means``.
+
+    Returns
+    -------
+    Calibration
+        Residuals are ``|a| - g`` per attitude, in readings, on the x component.
     """
     from scipy.optimize import least_squares
 
@@ -270,83 +310,3 @@ def calibrate_accel_free(means: np.ndarray, gravity: float = STANDARD_GRAVITY, u
             f"the accelerometer-to-case rotation is not observable; rms |a| residual {np.sqrt(np.mean(sol.fun**2)):.3g} m/s^2")
     return Calibration("accelerometer", m, b, sigma_m, np.sqrt(np.diag(cov)[6:]), units, "|a| = g fit (unknown attitudes)",
                        resid_norm, {}, (note,))
-
-
-def ferraris(acc: np.ndarray, gyr: np.ndarray, fs: float, sections: dict, turn_angle: float,
-             gravity: float = STANDARD_GRAVITY, acc_units: str = "m/s^2", gyr_units: str = "deg/s",
-             pairwise_bias: bool = True, g_sensitivity: bool = True) -> tuple[Calibration, Calibration]:
-    """A Ferraris session (six faces, one turn about each axis): accelerometer and gyro.
-
-    Parameters
-    ----------
-    acc, gyr : ndarray, shape (n, 3)
-        Readings, SI (m/s^2, rad/s).
-    fs : float
-        Hz.
-    sections : dict
-        imucal's section list: ``x_p``, ``x_a``, ... ``z_a`` (static faces) and
-        ``x_rot``, ``y_rot``, ``z_rot`` (turns), each ``(start, end)`` samples, end exclusive.
-    turn_angle : float
-        Signed angle of each turn about the axis pointing up, rad (imucal: -360 deg).
-    """
-    from align.alignment.job import AlignOptions, align
-    from align.alignment.plan import Plan, Step
-
-    need = list(FACES) + ["x_rot", "y_rot", "z_rot"]
-    missing = [k for k in need if k not in sections]
-    if missing:
-        raise InputError(f"missing sections {', '.join(missing)} (imucal's names: {', '.join(need)})", "sections")
-    for name, (a, b) in sections.items():
-        if not 0 <= a < b <= len(acc):
-            raise InputError(f"{a}..{b} is not inside the log's {len(acc)} samples", f"sections: {name}")
-    means = static_means(acc, {f: sections[f] for f in FACES}, 0.05 * gravity / np.median(np.linalg.norm(acc, axis=1)))
-    n = len(acc)
-    ups = {}
-    for f, (axis, sign) in FACES.items():
-        u = np.zeros(3)
-        u[axis] = sign
-        ups[f] = u
-    acc_cal = calibrate_accel(means, ups, gravity, acc_units, pairwise_bias=pairwise_bias)
-    a_true = acc_cal.correct(acc)
-    t = np.arange(n) / fs
-    g = np.array(gyr, float)
-    kga = None
-    notes = []
-    if g_sensitivity:
-        face_gyr = {f: gyr[a:b].mean(axis=0) for f, (a, b) in sections.items() if f in FACES}
-        kga = np.column_stack([(face_gyr[f"{a}_p"] - face_gyr[f"{a}_a"]) / (2 * gravity) for a in "xyz"])
-        g = g - a_true @ kga.T
-        notes.append("g-sensitivity K_ga from the static faces ((g(+i up) - g(-i up)) / 2g); it also absorbs the "
-                     "vertical Earth rate, which changes sign between the faces")
-    plan = Plan(tuple(Step(i, 1, angle=turn_angle) for i in range(3)))
-    segs = [Segment(f, "static", *sections[f]) for f in FACES]
-    segs += [Segment(f"{a}_rot", "angle", *sections[f"{a}_rot"], step=i) for i, a in enumerate("xyz")]
-    r = align(t, g, plan, AlignOptions(method="lsq", min_dwell=0.5, scale_tolerance=0.2), segs, gyr_units, "gyroscope")
-    notes += ["gyro: Eq 31 on the integrated turns, bias from the static faces (weighted least squares)",
-              "Earth rate not modelled: its vertical part differs between opposite faces and lands in K_ga (or, "
-              "without it, in the bias); the turns integrate at most 15.04 deg/h times their duration"]
-    residuals = {s.name: np.array(s.residual) for s in r.segments if s.kind == "static"}
-    gyro_cal = Calibration("gyroscope", r.M, r.bias, r.sigma_M, r.sigma_bias, gyr_units, "Ferraris turns, least squares",
-                           residuals, {}, tuple(notes), kga)
-    return acc_cal, gyro_cal
-
-
-def imucal_dict(acc: Calibration, gyr: Calibration) -> dict:
-    """The pair as imucal's ``FerrarisCalibrationInfo`` JSON (``K``, ``R``, ``b`` per sensor).
-
-    imucal's model is ``raw = K R true + b`` (plus ``K_ga a`` for the gyro), so
-    ``K = diag(|rows of M|)`` and ``R = K^-1 M``. Units: m/s^2 and deg/s.
-    """
-    def kr(m):
-        k = np.diag(np.linalg.norm(m, axis=1))
-        return k, np.linalg.inv(k) @ m
-
-    ka, ra = kr(acc.M)
-    kg, rg = kr(gyr.M)
-    deg = np.pi / 180
-    kga = np.zeros((3, 3)) if gyr.g_sensitivity is None else gyr.g_sensitivity / deg
-    return {"acc_unit": "m/s^2", "gyr_unit": "deg/s", "from_acc_unit": "m/s^2", "from_gyr_unit": "deg/s",
-            "comment": f"written by imu-align {__version__}: raw = K R true + b",
-            "K_a": ka.tolist(), "R_a": ra.tolist(), "b_a": acc.bias.tolist(),
-            "K_g": kg.tolist(), "R_g": rg.tolist(), "K_ga": kga.tolist(), "b_g": (gyr.bias / deg).tolist(),
-            "cal_type": "Ferraris", "_format_version": "2.0.0"}

@@ -5,37 +5,76 @@ field into an ellipsoid; the calibration maps it back:
 ``m_cal = W (m_raw - h)`` with ``W`` symmetric positive definite (``soft_iron``).
 
 Steps: centre and scale the data (conditioning only); fit the ellipsoid
-algebraically (Li and Griffiths 2004, ellipsoid-specific: ``4J - I^2 = 1``), or a
-sphere, or an axis-aligned ellipsoid; refine ``h`` and ``W`` geometrically
-(``sum (|W (m - h)| - F)^2``, Levenberg-Marquardt) to a known field strength or
-to the fitted one (``det W = 1`` scale). Gates refuse, with a clear message,
-data that cannot give a trustworthy answer: too few samples, planar or clustered
-captures (the hard iron's 1-sigma from the refinement exceeds 2 % of the field),
-a quadric that is not an ellipsoid, a reflected solution.
+algebraically (:mod:`align.calibration.ellipsoid`: Li and Griffiths 2004,
+ellipsoid-specific ``4J - I^2 = 1``, or a sphere, or an axis-aligned ellipsoid);
+refine ``h`` and ``W`` geometrically (``sum (|W (m - h)| - F)^2``, bounded trust
+region) to a known field strength or to the fitted one (``det W = 1`` scale).
+Gates refuse, with a clear message, data that cannot give a trustworthy answer:
+too few samples, planar or clustered captures (the hard iron's 1-sigma from the
+refinement exceeds 2 % of the field), a quadric that is not an ellipsoid, a
+reflected solution. With simultaneous accelerometer data,
+:func:`with_gravity_alignment` adds the rotation to the accelerometer frame.
+:class:`MagCalibration` is the registered result ``imu-align.magnetometer``.
 
 Public names
 ------------
-MagCalibration, calibrate_magnetometer, alignment_to_gravity, misalignment_from_axes_down, MODELS
+MagCalibration, calibrate_magnetometer, with_gravity_alignment, alignment_to_gravity, misalignment_from_axes_down,
+MODELS, FORMAT, CONVENTION
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from dataclasses import field as dataclass_field
+from typing import ClassVar
 
 import numpy as np
 
-from align import __version__
-from align.io import check_finite
+from align.calibration.ellipsoid import MODELS, algebraic_fit, pack, unpack
 from align.errors import InputError, TestError
-from align.units import DEG, to_unit
+from align.io import check_finite
+from align.results import Result, register
+from align.units import DEG, parse_unit, to_unit
 
-MODELS = ("sphere", "diagonal", "symmetric")
+FORMAT = "imu-align.magnetometer"
 CONVENTION = "m_cal = soft_iron (m_raw - hard_iron)"
 
 
-@dataclass(frozen=True)
-class MagCalibration:
-    """A magnetometer calibration (field quantities in SI, tesla, or raw counts)."""
+@register
+@dataclass(frozen=True, eq=False)
+class MagCalibration(Result):
+    """A magnetometer calibration, ``m_cal = soft_iron (m_raw - hard_iron)``.
+
+    Attributes
+    ----------
+    hard_iron, sigma_hard_iron : ndarray, shape (3,)
+        Offset and its 1-sigma, SI (tesla) or counts.
+    soft_iron : ndarray, shape (3, 3)
+        Symmetric positive definite ``W``, dimensionless.
+    field : float
+        Field strength after calibration, same unit as ``hard_iron``.
+    model : str
+        One of :data:`MODELS`.
+    units : str
+        File and display unit of the readings (``"uT"``, ``"gauss"``, ``"counts"``).
+    spread_before, spread_after : float
+        ``std(|m|) / mean(|m|)`` of the raw and calibrated readings.
+    coverage : float
+        Smallest eigenvalue of ``mean(u u^T)`` of the calibrated directions (1/3 for a full sphere).
+    heading_error : float
+        Predicted heading error, rad (1 sigma).
+    dip : float or None
+        Magnetic dip used for the prediction, rad.
+    notes : tuple of str
+    misalignment : ndarray, shape (3, 3), optional
+        Rotation to the accelerometer frame: ``m_body = misalignment m_cal``.
+    inputs : dict
+        The files and settings the calibration came from.
+    """
+
+    FORMAT: ClassVar[str] = FORMAT
+    VERSION: ClassVar[int] = 1
+    CONVENTION: ClassVar[str] = CONVENTION
 
     hard_iron: np.ndarray
     soft_iron: np.ndarray
@@ -50,16 +89,32 @@ class MagCalibration:
     dip: float | None
     notes: tuple = ()
     misalignment: np.ndarray | None = None
+    inputs: dict = dataclass_field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        object.__setattr__(self, "notes", tuple(self.notes))
+        object.__setattr__(self, "inputs", dict(self.inputs))
+
+    @property
+    def sensor(self) -> str:
+        """The sensor this result corrects: always ``"magnetometer"``."""
+        return "magnetometer"
+
+    def correction(self, sensor: str | None = None, where: str = "magnetometer") -> MagCalibration:
+        """This calibration, which corrects magnetometer logs (see :class:`align.results.Correction`)."""
+        return self._only_sensor("magnetometer", sensor, where)
 
     def correct(self, raw: np.ndarray) -> np.ndarray:
+        """``m_cal = W (raw - h)`` for readings of shape (n, 3), SI or counts."""
         return (np.asarray(raw) - self.hard_iron) @ self.soft_iron.T
 
     def to_dict(self) -> dict:
+        """The versioned JSON form: field quantities in ``self.units``, angles in deg."""
         u = self.units
         d = {
-            "format": "imu-align.magnetometer", "version": 1, "generator": f"imu-align {__version__}",
-            "sensor": "magnetometer", "convention": CONVENTION, "model": self.model,
-            "units": {"hard_iron": u, "field": u, "soft_iron": "1", "angles": "deg"},
+            **self.envelope({"hard_iron": u, "field": u, "soft_iron": "1", "angles": "deg"}),
+            "sensor": "magnetometer", "model": self.model,
             "hard_iron": to_unit(self.hard_iron, u).tolist(), "soft_iron": self.soft_iron.tolist(),
             "field": float(to_unit(self.field, u)),
             "uncertainty": {"level": "1 sigma", "hard_iron": to_unit(self.sigma_hard_iron, u).tolist()},
@@ -73,109 +128,32 @@ class MagCalibration:
         if self.misalignment is not None:
             d["misalignment"] = self.misalignment.tolist()
             d["misalignment_convention"] = "m_body = misalignment m_cal"
+        d["inputs"] = self.inputs
         return d
 
     @classmethod
-    def from_dict(cls, d: dict, where: str = "magnetometer") -> "MagCalibration":
-        from align.units import parse_unit
-
+    def from_dict(cls, d: dict, where: str = "magnetometer") -> MagCalibration:
+        """Read the form written by :meth:`to_dict` (any version up to the current one)."""
+        cls.check_envelope(d, where)
         try:
             u = d["units"]["hard_iron"]
-            f = parse_unit(u).factor
+            f = parse_unit(u, where=f"{where}: units.hard_iron").factor
             q = d["quality"]
             mis = d.get("misalignment")
-            return cls(np.array(d["hard_iron"], float) * f, np.array(d["soft_iron"], float).reshape(3, 3),
-                       float(d["field"]) * f, d["model"], u, np.array(d["uncertainty"]["hard_iron"], float) * f,
-                       q["field_spread_before"], q["field_spread_after"], q["coverage"],
-                       q["predicted_heading_error_deg"] * DEG, None if q["dip_deg"] is None else q["dip_deg"] * DEG,
-                       tuple(d.get("notes", [])), None if mis is None else np.array(mis, float))
+            return cls(
+                hard_iron=np.array(d["hard_iron"], float).reshape(3) * f,
+                soft_iron=np.array(d["soft_iron"], float).reshape(3, 3),
+                field=float(d["field"]) * f, model=d["model"], units=u,
+                sigma_hard_iron=np.array(d["uncertainty"]["hard_iron"], float).reshape(3) * f,
+                spread_before=q["field_spread_before"], spread_after=q["field_spread_after"], coverage=q["coverage"],
+                heading_error=q["predicted_heading_error_deg"] * DEG,
+                dip=None if q["dip_deg"] is None else q["dip_deg"] * DEG,
+                notes=tuple(d.get("notes", [])),
+                misalignment=None if mis is None else np.array(mis, float).reshape(3, 3),
+                inputs=dict(d.get("inputs") or {}),
+            )
         except (KeyError, TypeError, ValueError) as exc:
             raise InputError(f"malformed magnetometer calibration ({exc!r})", where) from None
-
-
-def _li_griffiths(x: np.ndarray) -> np.ndarray:
-    """Ellipsoid-specific algebraic fit (Li and Griffiths 2004): the 10 quadric coefficients.
-
-    ``a x^2 + b y^2 + c z^2 + 2f yz + 2g xz + 2h xy + 2p x + 2q y + 2r z + d = 0``
-    subject to ``4J - I^2 = 1`` (``I = a + b + c``, ``J = ab + bc + ca - f^2 - g^2 - h^2``),
-    solved as a generalised eigenproblem.
-    """
-    X, Y, Z = x.T
-    D = np.column_stack([X * X, Y * Y, Z * Z, 2 * Y * Z, 2 * X * Z, 2 * X * Y, 2 * X, 2 * Y, 2 * Z, np.ones(len(x))])
-    S = D.T @ D
-    S11, S12, S22 = S[:6, :6], S[:6, 6:], S[6:, 6:]
-    k = 4.0
-    C1 = np.zeros((6, 6))
-    C1[:3, :3] = k / 2 - 1
-    np.fill_diagonal(C1[:3, :3], -1.0)
-    C1[3:, 3:] = -k * np.eye(3)
-    try:
-        tmp = S11 - S12 @ np.linalg.solve(S22, S12.T)
-        w, v = np.linalg.eig(np.linalg.solve(C1, tmp))
-    except np.linalg.LinAlgError:
-        raise TestError("the capture is degenerate (no ellipsoid through it): rotate the device through all orientations",
-                        "magnetometer") from None
-    w, v = np.real(w), np.real(v)
-    pos = np.flatnonzero(w > -1e-9 * np.max(np.abs(w)))  # noise-free data put the answer at w = 0
-    if len(pos) == 0:
-        raise TestError("no ellipsoid fits these samples (the fitted quadric is not an ellipsoid)", "magnetometer")
-    v1 = v[:, pos[np.argmax(w[pos])]]
-    v2 = -np.linalg.solve(S22, S12.T @ v1)
-    return np.concatenate([v1, v2])
-
-
-def _quadric_to_ellipsoid(coef: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Centre ``c`` and shape ``Q`` (positive definite) with ``(x - c)^T Q (x - c) = 1``."""
-    a, b, c, f, g, h, p, q, r, d = coef
-    Q = np.array([[a, h, g], [h, b, f], [g, f, c]])
-    centre = -np.linalg.solve(Q, np.array([p, q, r]))
-    s = centre @ Q @ centre - d
-    Q = Q / s
-    if not np.all(np.linalg.eigvalsh(Q) > 0):
-        raise TestError("the fitted quadric is not an ellipsoid (non-positive axis): the data do not show "
-                        "an iron-distorted field; check the columns and the capture", "magnetometer")
-    return centre, Q
-
-
-def _sqrtm_spd(q: np.ndarray) -> np.ndarray:
-    w, v = np.linalg.eigh(q)
-    return (v * np.sqrt(w)) @ v.T
-
-
-def _initial(x: np.ndarray, model: str) -> tuple[np.ndarray, np.ndarray]:
-    """Algebraic fit on normalised data: centre and ``W`` with ``|W (x - c)| ~ 1``."""
-    if model == "sphere":
-        A = np.column_stack([2 * x, np.ones(len(x))])
-        sol, *_ = np.linalg.lstsq(A, np.sum(x * x, axis=1), rcond=None)
-        centre = sol[:3]
-        radius = np.sqrt(sol[3] + centre @ centre)
-        return centre, np.eye(3) / radius
-    if model == "diagonal":
-        A = np.column_stack([x * x, 2 * x, np.ones(len(x))])
-        sol, *_ = np.linalg.lstsq(A[:, :6], -A[:, 6], rcond=None)
-        coef = np.array([sol[0], sol[1], sol[2], 0, 0, 0, sol[3], sol[4], sol[5], 1.0])
-    else:
-        coef = _li_griffiths(x)
-    centre, Q = _quadric_to_ellipsoid(coef)
-    return centre, _sqrtm_spd(Q)
-
-
-def _pack(w: np.ndarray, model: str) -> np.ndarray:
-    if model == "sphere":
-        return np.array([w[0, 0]])
-    if model == "diagonal":
-        return np.diag(w).copy()
-    return w[np.triu_indices(3)]
-
-
-def _unpack(p: np.ndarray, model: str) -> np.ndarray:
-    if model == "sphere":
-        return np.eye(3) * p[0]
-    if model == "diagonal":
-        return np.diag(p)
-    w = np.zeros((3, 3))
-    w[np.triu_indices(3)] = p
-    return w + np.triu(w, 1).T
 
 
 def calibrate_magnetometer(m: np.ndarray, units: str = "uT", field: float | None = None, model: str = "symmetric",
@@ -187,6 +165,8 @@ def calibrate_magnetometer(m: np.ndarray, units: str = "uT", field: float | None
     ----------
     m : ndarray, shape (n, 3)
         Raw readings, SI (tesla) or counts.
+    units : str
+        Unit of the readings, for the result's file form (``"uT"``, ``"counts"``).
     field : float, optional
         Known field strength (same unit as ``m``); otherwise the fitted one (``det W = 1``).
     model : {"sphere", "diagonal", "symmetric"}
@@ -196,11 +176,20 @@ def calibrate_magnetometer(m: np.ndarray, units: str = "uT", field: float | None
         Magnetic dip (rad) when no accelerometer is given; default 60 deg, said in the notes.
     max_hard_iron_sigma : float
         Refuse when the hard iron's 1-sigma exceeds this fraction of the field.
+
+    Returns
+    -------
+    MagCalibration
+
+    Raises
+    ------
+    TestError
+        The capture cannot give a trustworthy answer (planar, poor coverage, not an ellipsoid).
     """
     from scipy.optimize import least_squares
 
     if model not in MODELS:
-        raise InputError(f"unknown model '{model}'; choose {', '.join(MODELS)}", "--model")
+        raise InputError(f"unknown model '{model}'; choose {', '.join(MODELS)}", "{model}")
     m = np.asarray(m, float)
     check_finite(m, "magnetometer")
     n_par = {"sphere": 4, "diagonal": 6, "symmetric": 9}[model]
@@ -217,12 +206,12 @@ def calibrate_magnetometer(m: np.ndarray, units: str = "uT", field: float | None
         raise TestError(f"planar or near-level capture: the samples barely leave a plane (thickness {sv[2] / sv[0]:.2f} of "
                         "their width); tilt the device through all orientations (a figure-eight in every direction)",
                         "magnetometer")
-    centre, w = _initial(x, model)
+    centre, w = algebraic_fit(x, model)
     target = None if field is None else field / s0
-    p0 = np.concatenate([centre, _pack(w, model)])
+    p0 = np.concatenate([centre, pack(w, model)])
 
     def resid(p):
-        wm = _unpack(p[3:], model)
+        wm = unpack(p[3:], model)
         r = np.linalg.norm((x - p[:3]) @ wm.T, axis=1)
         return r - (1.0 if target is None else target)
 
@@ -235,7 +224,7 @@ def calibrate_magnetometer(m: np.ndarray, units: str = "uT", field: float | None
         raise TestError("coverage too small: the fit runs away along the poorly covered direction (the geometric "
                         "refinement reached its bound); rotate the device through more orientations", "magnetometer")
     notes_refine = "geometric refinement (trust region) from the algebraic Li-Griffiths fit"
-    centre, w = sol.x[:3], _unpack(sol.x[3:], model)
+    centre, w = sol.x[:3], unpack(sol.x[3:], model)
     if target is None:  # the fitted field: scale W to unit determinant, |m_cal| is then the field
         det = np.linalg.det(w)
         if not det > 0:
@@ -274,7 +263,8 @@ def calibrate_magnetometer(m: np.ndarray, units: str = "uT", field: float | None
         notes.append(f"dip {np.degrees(dip):.2f} deg from the accelerometer (median angle between field and gravity)")
     elif dip is None:
         dip = 60 * DEG
-        notes.append("dip not measured: heading error predicted for 60 deg (mid latitudes); give accelerometer data for the real one")
+        notes.append("dip not measured: heading error predicted for 60 deg (mid latitudes); "
+                     "give accelerometer data for the real one")
     horizontal = field_si * np.cos(dip)
     heading = float(np.arctan2(np.std(norms - field_si), horizontal))
     notes.append("predicted heading error: the residual field-magnitude scatter seen across the horizontal field (1 sigma)")
@@ -307,3 +297,27 @@ def alignment_to_gravity(m_cal: np.ndarray, acc: np.ndarray) -> tuple[np.ndarray
     p0 = np.array([0.0, 0.0, 0.0, float(np.median(np.arcsin(np.clip(np.sum(ah * mh, axis=1), -1, 1))))])
     sol = least_squares(resid, p0)
     return Rotation.from_rotvec(sol.x[:3]).as_matrix(), float(sol.x[3]), float(np.std(sol.fun))
+
+
+def with_gravity_alignment(cal: MagCalibration, m: np.ndarray, acc: np.ndarray) -> MagCalibration:
+    """``cal`` with its rotation to the accelerometer frame, found from gravity (:func:`alignment_to_gravity`).
+
+    Parameters
+    ----------
+    cal : MagCalibration
+        A calibration of the capture ``m``.
+    m : ndarray, shape (n, 3)
+        The raw magnetometer readings ``cal`` was fitted to, SI or counts.
+    acc : ndarray, shape (n, 3)
+        Simultaneous accelerometer readings (any unit).
+
+    Returns
+    -------
+    MagCalibration
+        ``cal`` with ``misalignment`` set (``m_body = misalignment m_cal``) and a note
+        giving the fitted dip and the remaining scatter.
+    """
+    rot, dip_fit, scatter = alignment_to_gravity(cal.correct(m), np.asarray(acc, float))
+    note = (f"rotation to the accelerometer frame from gravity: dip {np.degrees(dip_fit):.2f} deg, "
+            f"scatter {np.degrees(scatter):.2f} deg after alignment")
+    return cal.replace(misalignment=rot, notes=cal.notes + (note,))

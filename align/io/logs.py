@@ -184,7 +184,7 @@ def _require(names: list[str] | None, available: list[str], path) -> None:
     if missing:
         raise InputError(
             f"no column {', '.join(repr(m) for m in missing)} (columns: {', '.join(available) or 'none'}); "
-            "name the columns with --columns",
+            "name the columns with {columns}",
             str(path),
         )
 
@@ -216,7 +216,7 @@ def read_log(
     t : ndarray, shape (n,)
     data : ndarray, shape (n, len(columns)), SI
     """
-    factor = parse_unit(units, expect, "--units" if expect != "angular_rate" else "--gyro-units").factor
+    factor = parse_unit(units, expect, "{units}" if expect != "angular_rate" else "{gyro_units}").factor
     use_time = time_column is not None and rate_hz is None
     wanted = ([time_column] if use_time else []) + list(columns)
     p = Path(path)
@@ -225,7 +225,7 @@ def read_log(
         if arr.shape[1] != len(wanted):
             raise InputError(
                 f"has {arr.shape[1]} columns; expected {len(wanted)} ({', '.join(wanted)})"
-                + ("" if use_time else "") + ("; give --rate-hz for a file without time" if use_time else ""),
+                + ("" if use_time else "") + ("; give {rate_hz} for a file without time" if use_time else ""),
                 str(path),
             )
         data = arr
@@ -235,7 +235,7 @@ def read_log(
         t, values = data[:, 0], data[:, 1:]
     else:
         if not rate_hz or rate_hz <= 0:
-            raise InputError("no time column: give --rate-hz", str(path))
+            raise InputError("no time column: give {rate_hz}", str(path))
         t, values = np.arange(len(data)) / rate_hz, data
     return np.ascontiguousarray(t), values * factor
 
@@ -257,7 +257,7 @@ class NpyChunks:
         if p.suffix.lower() in (".bin", ".f8", ".f4", ".raw"):
             dtype = np.dtype("<f4" if p.suffix.lower() == ".f4" else "<f8")
             if not channels:
-                raise InputError("a raw binary file needs its number of columns (--columns)", str(path))
+                raise InputError("a raw binary file needs its number of columns ({columns})", str(path))
             size = p.stat().st_size
             if size % (dtype.itemsize * channels):
                 raise InputError(f"{size} bytes is not a whole number of {channels}-column {dtype} rows", str(path))
@@ -310,10 +310,10 @@ def read_static(log: str | Path, names: list[str], rate_hz: float | None):
     log = Path(log)
     if log.suffix.lower() in (".npy", ".bin", ".f8", ".f4", ".raw"):
         if rate_hz is None:
-            raise InputError(f"a {log.suffix} file has no time: give --rate-hz", str(log))
+            raise InputError(f"a {log.suffix} file has no time: give {{rate_hz}}", str(log))
         source = NpyChunks(log, len(names))
         if source.shape[1] != len(names):
-            raise InputError(f"array of shape {source.shape} has {source.shape[1]} columns; name them all with --columns",
+            raise InputError(f"array of shape {source.shape} has {source.shape[1]} columns; name them all with {{columns}}",
                              str(log))
         return source, float(rate_hz)
     wanted = names if rate_hz is not None else ["time"] + names

@@ -1,1 +1,44 @@
-"""TODO"""
+"""The noise family: Allan deviation, the IEEE noise model and its fit, the simulator, test planning.
+
+Modules
+-------
+model     the IEEE Std 952 five-term Allan-variance model (one place): TERMS, NoiseModel, model_adev
+allan     overlapping / modified Allan deviation of many channels, confidence intervals (numba kernels in _kernels)
+fit       whole-model noise fit, IEEE point readouts, the seed's noise figures
+sim       sensor-error simulator and the seed's three error models
+planner   averaging time and test plan (reference Example 3); result ``imu-align.plan``
+job       the Allan job (logs -> deviation, fits, figures); result ``imu-align.allan``
+
+The plot of an Allan job is :func:`align.present.plots.allan_plot_png` (this
+family draws nothing). Note that ``align.noise.allan`` as an attribute of this
+package is the function :func:`~align.noise.allan.allan`; import the module's
+other names with ``from align.noise.allan import ...`` (or from here).
+
+Public names
+------------
+TERMS, NOISE_ALPHA, FLICKER_FACTOR, NoiseModel, avar_design, model_avar, model_adev (model);
+tau_grid, AllanResult, allan, ArrayChunks, window_stability, edf_overlapping, confidence_interval (allan);
+NoiseFit, fit_noise, point_readouts, noise_figures, nnls_small (fit);
+NoiseSpec, FLICKER_MODELS, simulate_noise, simulate_imu, seed_method_a, seed_method_b, seed_restoring (sim);
+PlanResult, Averaging, noise_target, model_curve, averaging_time, longest_turn, make_plan (planner);
+AllanJob, run_allan, read_runs, plan_from_allan, term_units (job)
+"""
+
+from align.noise.model import FLICKER_FACTOR, NOISE_ALPHA, TERMS, NoiseModel, avar_design, model_adev, model_avar
+from align.noise.allan import (AllanResult, ArrayChunks, allan, confidence_interval, edf_overlapping, tau_grid,
+                               window_stability)
+from align.noise.fit import NoiseFit, fit_noise, nnls_small, noise_figures, point_readouts
+from align.noise.sim import (FLICKER_MODELS, NoiseSpec, seed_method_a, seed_method_b, seed_restoring, simulate_imu,
+                             simulate_noise)
+from align.noise.planner import (Averaging, PlanResult, averaging_time, longest_turn, make_plan, model_curve,
+                                 noise_target, preset_model)
+from align.noise.job import AllanJob, plan_from_allan, read_runs, run_allan, term_units
+
+__all__ = [
+    "FLICKER_FACTOR", "NOISE_ALPHA", "TERMS", "NoiseModel", "avar_design", "model_adev", "model_avar",
+    "AllanResult", "ArrayChunks", "allan", "confidence_interval", "edf_overlapping", "tau_grid", "window_stability",
+    "NoiseFit", "fit_noise", "nnls_small", "noise_figures", "point_readouts",
+    "FLICKER_MODELS", "NoiseSpec", "seed_method_a", "seed_method_b", "seed_restoring", "simulate_imu", "simulate_noise",
+    "Averaging", "PlanResult", "averaging_time", "longest_turn", "make_plan", "model_curve", "noise_target", "preset_model",
+    "AllanJob", "plan_from_allan", "read_runs", "run_allan", "term_units",
+]

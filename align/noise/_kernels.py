@@ -1,4 +1,4 @@
-"""Compiled kernels of :mod:`align.allan` (numba), imported on first use.
+"""Compiled kernels of :mod:`align.noise.allan` (numba), imported on first use.
 
 Module-level functions so that numba's on-disk cache (``cache=True``) holds
 them between runs.

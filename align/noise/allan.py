@@ -18,7 +18,8 @@ type dominant at each tau, and chi-square quantiles.
 
 Public names
 ------------
-tau_grid, AllanResult, allan, ArrayChunks, window_stability, edf_overlapping, confidence_interval, NOISE_ALPHA
+tau_grid, AllanResult, allan, ArrayChunks, window_stability, edf_overlapping, confidence_interval,
+NOISE_ALPHA (from :mod:`align.noise.model`)
 """
 
 from __future__ import annotations
@@ -30,9 +31,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from align.errors import InputError
+from align.noise.model import NOISE_ALPHA
+from align.values import Value, frozen_array
 
-#: power-law exponent alpha of the frequency PSD (S_y ~ f^alpha) for each noise term
-NOISE_ALPHA = {"quantization": 2, "white": 0, "flicker": -1, "random_walk": -2, "ramp": -2}
+__all__ = ["tau_grid", "AllanResult", "allan", "ArrayChunks", "window_stability", "edf_overlapping",
+           "confidence_interval", "NOISE_ALPHA"]
 
 
 def tau_grid(n: int, fs: float, grid: str | list = "dense", per_decade: int = 10) -> np.ndarray:
@@ -40,12 +43,24 @@ def tau_grid(n: int, fs: float, grid: str | list = "dense", per_decade: int = 10
 
     Parameters
     ----------
+    n : int
+        Rate samples in the record.
+    fs : float
+        Sample rate, Hz.
     grid : {"dense", "octave", "decade"} or list of float
         ``dense``: log-spaced, ``per_decade`` points per decade; ``octave``:
         powers of two; ``decade``: 1, 2, 4 x 10^k; a list: explicit taus in seconds.
+    per_decade : int
+
     Returns
     -------
-    ndarray of int64, strictly increasing, ``1 <= m <= (n - 1) // 2``.
+    ndarray of int64, shape (T,)
+        Strictly increasing, ``1 <= m <= (n - 1) // 2``.
+
+    Raises
+    ------
+    InputError
+        An unknown grid, or no tau of it fitting the record (``where`` is ``{grid}``).
     """
     m_max = (n - 1) // 2  # at least two second differences behind every point
     if m_max < 1:
@@ -59,12 +74,12 @@ def tau_grid(n: int, fs: float, grid: str | list = "dense", per_decade: int = 10
         elif grid == "decade":
             m = np.array([d * 10.0**e for e in range(0, int(np.log10(m_max)) + 1) for d in (1, 2, 4)])
         else:
-            raise InputError(f"unknown grid '{grid}'; use dense, octave, decade or a list of taus", "--grid")
+            raise InputError(f"unknown grid '{grid}'; use dense, octave, decade or a list of taus", "{grid}")
     else:
         m = np.round(np.asarray(grid, dtype=float) * fs)
     m = np.unique(m[(m >= 1) & (m <= m_max)]).astype(np.int64)
     if len(m) == 0:
-        raise InputError("no tau of the grid fits the record", "--taus")
+        raise InputError(f"no tau of the grid fits the record ({n} samples at {fs:g} Hz)", "{grid}")
     return m
 
 
@@ -189,8 +204,8 @@ def confidence_interval(dev: np.ndarray, edf: np.ndarray, level: float = 0.68268
     return lo, hi
 
 
-@dataclass(frozen=True)
-class AllanResult:
+@dataclass(frozen=True, eq=False)
+class AllanResult(Value):
     """Allan deviation of several channels (in the unit of the input, e.g. rad/s).
 
     Attributes
@@ -209,6 +224,8 @@ class AllanResult:
         Mean of each channel (seed 002 Eq 5).
     stability : dict
         Period (s) -> ndarray (C,): bias stability (seed 002 Eq 7).
+
+    Arrays (also those of ``stability``) are read-only copies; ``==`` compares by value.
     """
 
     tau: np.ndarray
@@ -221,15 +238,22 @@ class AllanResult:
     bias: np.ndarray | None = None
     stability: dict | None = None
 
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        object.__setattr__(self, "names", tuple(self.names))
+        if self.stability is not None:
+            object.__setattr__(self, "stability", {float(p): frozen_array(v) for p, v in self.stability.items()})
+
     @property
     def n_phase(self) -> int:
         return self.n + 1
 
-    def scaled(self, factor: float) -> "AllanResult":
+    def scaled(self, factor: float) -> AllanResult:
         """The same result with the data unit scaled by ``factor`` (deviations are linear in it)."""
-        return AllanResult(self.tau, self.m, self.adev * factor, None if self.mdev is None else self.mdev * factor,
-                           self.n, self.fs, self.names, None if self.bias is None else self.bias * factor,
-                           None if self.stability is None else {p: v * factor for p, v in self.stability.items()})
+        return self.replace(adev=self.adev * factor, mdev=None if self.mdev is None else self.mdev * factor,
+                            bias=None if self.bias is None else self.bias * factor,
+                            stability=None if self.stability is None else
+                            {p: v * factor for p, v in self.stability.items()})
 
 
 def allan(data, fs: float, names=None, grid="dense", per_decade: int = 10, modified: bool = False,

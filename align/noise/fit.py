@@ -1,6 +1,7 @@
 """Whole-model noise fit of an Allan variance curve, IEEE point readouts, noise figures.
 
-Model (IEEE Std 952 / 1554, reference section 6)::
+The five-term model of :mod:`align.noise.model` (IEEE Std 952 / 1554, reference
+section 6)::
 
     sigma^2(tau) = 3 Q^2 / tau^2 + N^2 / tau + (2 ln 2 / pi) B^2 + K^2 tau / 3 + R^2 tau^2 / 2
 
@@ -14,7 +15,8 @@ beside it, labelled as such.
 
 Public names
 ------------
-TERMS, NoiseFit, fit_noise, point_readouts, model_adev, noise_figures
+NoiseFit, fit_noise, point_readouts, noise_figures, nnls_small;
+TERMS, model_adev (from :mod:`align.noise.model`)
 """
 
 from __future__ import annotations
@@ -23,25 +25,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from align.noise.allan import NOISE_ALPHA, AllanResult, confidence_interval, edf_overlapping
+from align.noise.allan import AllanResult, confidence_interval, edf_overlapping
+from align.noise.model import FLICKER_FACTOR, NOISE_ALPHA, TERMS, NoiseModel, avar_design, model_adev
+from align.values import Value
 
-TERMS = ("quantization", "white", "flicker", "random_walk", "ramp")
-_LN = 2 * np.log(2) / np.pi
-
-
-def _design(tau: np.ndarray) -> np.ndarray:
-    """Columns of the Allan-variance model for the squared parameters (Q^2, N^2, B^2, K^2, R^2)."""
-    tau = np.asarray(tau, dtype=float)
-    return np.column_stack([3 / tau**2, 1 / tau, np.full_like(tau, _LN), tau / 3, tau**2 / 2])
+__all__ = ["NoiseFit", "fit_noise", "point_readouts", "noise_figures", "nnls_small", "TERMS", "model_adev"]
 
 
-def model_adev(tau, params) -> np.ndarray:
-    """Allan deviation of the model for parameters ``(Q, N, B, K, R)`` (SI)."""
-    return np.sqrt(_design(tau) @ np.square(np.asarray(params, dtype=float)))
-
-
-@dataclass(frozen=True)
-class NoiseFit:
+@dataclass(frozen=True, eq=False)
+class NoiseFit(Value):
     """Fitted noise terms of one channel (SI: rad, rad/sqrt(s), rad/s, rad/s/sqrt(s), rad/s^2 for a gyro).
 
     Attributes
@@ -73,6 +65,17 @@ class NoiseFit:
     ci_high: np.ndarray
     readouts: dict
 
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        for name in ("identifiable", "notes", "dominant"):
+            object.__setattr__(self, name, tuple(getattr(self, name)))
+        object.__setattr__(self, "readouts", {k: float(v) for k, v in self.readouts.items()})
+
+    @property
+    def model(self) -> NoiseModel:
+        """The fitted terms as a :class:`~align.noise.model.NoiseModel` (a curve ``sigma(tau)``)."""
+        return NoiseModel.from_params(self.params)
+
 
 def nnls_small(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Non-negative least squares for a handful of unknowns, exactly, by enumerating supports.
@@ -96,7 +99,7 @@ def nnls_small(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _nnls_fit(tau, avar, edf):
-    a = _design(tau)
+    a = avar_design(tau)
     w = np.sqrt(edf / 2.0) / avar          # 1 / (relative sigma of AVAR) / AVAR
     aw, bw = a * w[:, None], avar * w
     scale = np.linalg.norm(aw, axis=0)
@@ -113,7 +116,7 @@ def fit_noise(res: AllanResult, channel: int, min_edf: float = 2.0) -> NoiseFit:
     for _ in range(2):
         use = (edf >= min_edf) & (avar > 0)
         p, aw, bw = _nnls_fit(tau[use], avar[use], edf[use])
-        contrib = _design(tau) * p[None, :]
+        contrib = avar_design(tau) * p[None, :]
         dominant = tuple(TERMS[int(k)] for k in np.argmax(contrib, axis=1))
         edf = edf_overlapping(res.n_phase, res.m, np.array([NOISE_ALPHA[d] for d in dominant]))
     use = (edf >= min_edf) & (avar > 0)
@@ -130,7 +133,7 @@ def fit_noise(res: AllanResult, channel: int, min_edf: float = 2.0) -> NoiseFit:
         cov[np.ix_(active, active)] = c
     var_p = np.diag(cov)
     sigma = np.where(active, np.sqrt(np.abs(var_p)) / (2 * np.where(params > 0, params, 1.0)), np.nan)
-    contrib = _design(tau) * p[None, :]
+    contrib = avar_design(tau) * p[None, :]
     model = contrib.sum(axis=1)
     share = np.where(use[:, None], contrib / np.maximum(model, 1e-300)[:, None], 0.0).max(axis=0)
     ident, notes = [], []
@@ -156,7 +159,7 @@ def _why(term, params, share, rel, tau, use, hi, model, res) -> str:
     reliable = np.flatnonzero(use & (res.n_phase - 2 * res.m >= 5))
     last = reliable[-1] if len(reliable) else np.flatnonzero(use)[-1]
     room = max(hi[last] ** 2 - model[last], 1e-300)
-    floor = max(_LN * params[2] ** 2 + params[1] ** 2 / tau[last], 1e-300)
+    floor = max(FLICKER_FACTOR * params[2] ** 2 + params[1] ** 2 / tau[last], 1e-300)
     if term == "random_walk":
         bound = np.sqrt(3 * room / tau[last])
         cross = 3 * floor / bound**2

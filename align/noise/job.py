@@ -1,23 +1,44 @@
-"""The Allan job: logs -> Allan deviation, fits, noise figures, plan; its JSON form and plot.
+"""The Allan job: logs -> Allan deviation, fits, noise figures, plan; its JSON form.
+
+:func:`run_allan` computes the overlapping (and modified) Allan deviation of
+the first run (:mod:`align.noise.allan`), fits the five-term IEEE model to each
+channel (:mod:`align.noise.fit`), and reads the seed's noise figures (bias,
+bias stability; seed 002 Eq 5-8) of every run. :class:`AllanJob` is the
+registered result (format ``imu-align.allan``): it writes itself with
+``to_dict`` and reads itself back with ``from_dict``. Its plot lives in
+:mod:`align.present.plots` (``allan_plot_png``).
 
 Public names
 ------------
-AllanJob, run_allan, term_units, allan_plot_png
+AllanJob, run_allan, read_runs, plan_from_allan, term_units, FORMAT
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
 
-from align.noise.allan import AllanResult, allan
-from align.noise.fit import TERMS, fit_noise, model_adev
+from align.errors import InputError
+from align.noise.allan import NOISE_ALPHA, AllanResult, allan, edf_overlapping
+from align.noise.fit import NoiseFit, fit_noise
+from align.noise.model import TERMS, avar_design
+from align.noise.planner import PlanResult, make_plan
+from align.results import Result, register
 from align.units import parse_unit, to_unit
+
+FORMAT = "imu-align.allan"
 
 #: display units of the five terms for gyros and accelerometers
 _GYRO = ("deg", "deg/sqrt(h)", "deg/h", "deg/h/sqrt(h)", "deg/h^2")
 _ACCEL = ("m/s", "m/s/sqrt(h)", "ug", "ug/sqrt(h)", "ug/h")
+_FIT_METHOD = "weighted non-negative least squares on the Allan variance (IEEE 952 five-term model)"
+_FIGURES_METHOD = ("seed 002 Eq 5-8: mean of each run; std (ddof 1) of consecutive P-second means, "
+                   "averaged over runs")
+#: the IEEE point readouts: key in NoiseFit.readouts -> (JSON key, JSON unit key, term index)
+_READOUTS = {"N_tau1": ("N_at_tau_1s", "N_unit", 1), "B_floor": ("B_floor_over_0.664", "B_unit", 2),
+             "K_tau3": ("K_at_tau_3s", "K_unit", 3)}
 
 
 def term_units(units: str) -> tuple[str, ...]:
@@ -26,9 +47,30 @@ def term_units(units: str) -> tuple[str, ...]:
     return _GYRO if u.dim == parse_unit("rad/s").dim else _ACCEL
 
 
-@dataclass(frozen=True)
-class AllanJob:
-    """Result of :func:`run_allan` (SI inside; ``units`` is the input unit)."""
+@register
+@dataclass(frozen=True, eq=False)
+class AllanJob(Result):
+    """Result of :func:`run_allan` (SI inside; ``units`` is the input unit).
+
+    Attributes
+    ----------
+    result : AllanResult
+        Allan deviation of the first run, SI.
+    fits : tuple of NoiseFit
+        One per channel.
+    figures : tuple of dict
+        One per channel: ``{"bias": float, "stability": {period_s: float}}``,
+        averaged over the runs (SI).
+    repeatability : ndarray, shape (C,), or None
+        Run-to-run std (ddof 1) of the bias, SI (None for one run).
+    units : str
+        Unit of the input data (a rate or an acceleration).
+    runs : int
+    inputs : tuple of str
+        The recordings, the first one being the one whose deviation is shown.
+    plan : PlanResult or None
+        A test plan from the curve, when one was asked for.
+    """
 
     result: AllanResult
     fits: tuple
@@ -36,73 +78,186 @@ class AllanJob:
     repeatability: np.ndarray | None
     units: str
     runs: int
-    inputs: list = field(default_factory=list)
+    inputs: tuple = ()
+    plan: PlanResult | None = None
 
-    def to_dict(self) -> dict:
-        from align import __version__
+    FORMAT: ClassVar[str] = FORMAT
+    VERSION: ClassVar[int] = 1
+    CONVENTION: ClassVar[str] = ("overlapping Allan deviation (IEEE Std 1139, NIST SP 1065); noise model "
+                                 "sigma^2(tau) = 3 Q^2/tau^2 + N^2/tau + (2 ln 2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2 "
+                                 "(IEEE Std 952)")
 
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        for name in ("fits", "figures", "inputs"):
+            object.__setattr__(self, name, tuple(getattr(self, name)))
+
+    @property
+    def sensor(self) -> str:
+        """``"gyroscope"`` for rate data, ``"accelerometer"`` otherwise."""
+        return "gyroscope" if term_units(self.units) is _GYRO else "accelerometer"
+
+    def to_dict(self) -> dict[str, Any]:
+        """The versioned JSON form: deviations in ``units``, terms in engineering units."""
         r, u = self.result, self.units
         tu = term_units(u)
-        kind = "gyroscope" if tu is _GYRO else "accelerometer"
+        periods = list(self.figures[0]["stability"]) if self.figures else []
         d = {
-            "format": "imu-align.allan", "version": 1, "generator": f"imu-align {__version__}",
-            "units": {"tau": "s", "adev": u, "ci": "68.3 % (1 sigma) chi-square interval",
-                      "terms": dict(zip(TERMS, tu)), "bias": u},
-            "sensor": kind, "fs_hz": r.fs, "samples": r.n, "runs": self.runs,
+            **self.envelope({"tau": "s", "adev": u, "ci": "68.3 % (1 sigma) chi-square interval",
+                             "terms": dict(zip(TERMS, tu)), "bias": u}),
+            "sensor": self.sensor, "fs_hz": r.fs, "samples": r.n, "runs": self.runs,
             "tau": r.tau.tolist(),
+            "m": r.m.tolist(),
             "adev": {n: to_unit(r.adev[j], u).tolist() for j, n in enumerate(r.names)},
             "ci_low": {n: to_unit(f.ci_low, u).tolist() for n, f in zip(r.names, self.fits)},
             "ci_high": {n: to_unit(f.ci_high, u).tolist() for n, f in zip(r.names, self.fits)},
-            "fit": {},
-            "figures": {},
-            "inputs": self.inputs,
+            "fit": {n: self._fit_dict(f, tu) for n, f in zip(r.names, self.fits)},
+            "figures": {n: {**_figures_dict(fig["bias"], fig["stability"], u), "method": _FIGURES_METHOD}
+                        for n, fig in zip(r.names, self.figures)},
+            "periods_s": periods,
+            "adev_run_figures": None if r.bias is None else {
+                n: _figures_dict(r.bias[j], {p: v[j] for p, v in (r.stability or {}).items()}, u)
+                for j, n in enumerate(r.names)},
+            "inputs": list(self.inputs),
         }
         if r.mdev is not None:
             d["mdev"] = {n: [None if not np.isfinite(v) else v for v in to_unit(r.mdev[j], u).tolist()]
                          for j, n in enumerate(r.names)}
-        for name, f, fig in zip(r.names, self.fits, self.figures):
-            terms = {}
-            for k, t in enumerate(TERMS):
-                val, sig = _term(f.params[k], k, u, tu), _term(f.sigma[k], k, u, tu)
-                terms[t] = {"value": val, "sigma": sig, "unit": tu[k], "identifiable": bool(f.identifiable[k])}
-            si = f.params
-            d["fit"][name] = {
-                "method": "weighted non-negative least squares on the Allan variance (IEEE 952 five-term model)",
-                "terms": terms, "notes": list(f.notes),
-                "ieee_point_readouts": {
-                    "N_at_tau_1s": _term(f.readouts["N_tau1"], 1, u, tu), "N_unit": tu[1],
-                    "B_floor_over_0.664": _term(f.readouts["B_floor"], 2, u, tu), "B_unit": tu[2],
-                    "K_at_tau_3s": _term(f.readouts["K_tau3"], 3, u, tu), "K_unit": tu[3],
-                },
-                "continuous": {  # Kalibr-style densities, SI
-                    f"{'gyroscope' if kind == 'gyroscope' else 'accelerometer'}_noise_density": float(si[1]),
-                    f"{'gyroscope' if kind == 'gyroscope' else 'accelerometer'}_random_walk": float(si[3]),
-                    "units": "rad/s/sqrt(Hz), rad/s^2/sqrt(Hz)" if kind == "gyroscope" else "m/s^2/sqrt(Hz), m/s^3/sqrt(Hz)",
-                },
-            }
-            d["figures"][name] = {"bias": to_unit(fig["bias"], u),
-                                  "bias_stability": {f"{p:g} s": to_unit(v, u) for p, v in fig["stability"].items()},
-                                  "method": "seed 002 Eq 5-8: mean of each run; std (ddof 1) of consecutive P-second means, averaged over runs"}
         d["adev_of"] = self.inputs[0] if self.inputs else "first run"
         if self.repeatability is not None:
             d["repeatability"] = {n: to_unit(v, u) for n, v in zip(r.names, self.repeatability)}
+        if self.plan is not None:
+            d["plan"] = self.plan.to_dict()
         return d
 
+    def _fit_dict(self, f: NoiseFit, tu: tuple[str, ...]) -> dict[str, Any]:
+        terms = {t: {"value": _term(f.params[k], tu[k]), "sigma": _term(f.sigma[k], tu[k]), "unit": tu[k],
+                     "identifiable": bool(f.identifiable[k])} for k, t in enumerate(TERMS)}
+        readouts = {}
+        for key, (name, unit_key, k) in _READOUTS.items():
+            readouts[name], readouts[unit_key] = _term(f.readouts[key], tu[k]), tu[k]
+        kind = self.sensor
+        return {
+            "method": _FIT_METHOD, "terms": terms, "notes": list(f.notes),
+            "ieee_point_readouts": readouts,
+            "continuous": {  # Kalibr-style densities, SI
+                f"{kind}_noise_density": float(f.params[1]),
+                f"{kind}_random_walk": float(f.params[3]),
+                "units": "rad/s/sqrt(Hz), rad/s^2/sqrt(Hz)" if kind == "gyroscope" else "m/s^2/sqrt(Hz), m/s^3/sqrt(Hz)",
+            },
+            "dominant": list(f.dominant),
+            "edf": f.edf.tolist(),
+        }
 
-def _term(value: float, k: int, units: str, tu) -> float | None:
-    """An SI term value in its engineering unit (scaled by the input unit's kind)."""
+    @classmethod
+    def from_dict(cls, d: dict[str, Any], where: str = "result") -> AllanJob:
+        """Read the form written by :meth:`to_dict` (files written before ``m``, ``edf``,
+        ``dominant`` and ``adev_run_figures`` were added read too: those are rebuilt)."""
+        cls.check_envelope(d, where)
+        try:
+            u = d["units"]["adev"]
+            f = parse_unit(u, None, f"{where}: units.adev").factor
+            tu = term_units(u)
+            names = tuple(d["adev"])
+            fs, n, runs = float(d["fs_hz"]), int(d["samples"]), int(d["runs"])
+            tau = np.array(d["tau"], dtype=float)
+            m = np.array(d["m"], dtype=np.int64) if "m" in d else np.round(tau * fs).astype(np.int64)
+            adev = np.array([d["adev"][k] for k in names], dtype=float) * f
+            mdev = np.array([d["mdev"][k] for k in names], dtype=float) * f if "mdev" in d else None
+            periods = _periods(d, names)
+            figures = tuple(_read_figures(d["figures"][k], periods, f) for k in names)
+            run = d.get("adev_run_figures", d["figures"] if runs == 1 else None)
+            bias = stability = None
+            if run is not None:
+                own = [_read_figures(run[k], periods, f) for k in names]
+                bias = np.array([g["bias"] for g in own])
+                stability = {p: np.array([g["stability"][p] for g in own]) for p in periods}
+            result = AllanResult(tau, m, adev, mdev, n, fs, names, bias, stability)
+            fits = tuple(_read_fit(d["fit"][k], tu, result, np.array(d["ci_low"][k], dtype=float) * f,
+                                   np.array(d["ci_high"][k], dtype=float) * f) for k in names)
+            rep = d.get("repeatability")
+            return cls(result, fits, figures, None if rep is None else np.array([rep[k] for k in names], dtype=float) * f,
+                       u, runs, tuple(d.get("inputs", ())),
+                       PlanResult.from_dict(d["plan"], f"{where}: plan") if "plan" in d else None)
+        except (KeyError, TypeError, ValueError, IndexError) as exc:
+            raise InputError(f"malformed {FORMAT} result ({exc!r}); regenerate it", where) from None
+
+
+def _term(value: float, unit: str) -> float | None:
+    """An SI term value in its engineering unit (None when not finite)."""
     if not np.isfinite(value):
         return None
-    return float(to_unit(value, tu[k]))
+    return float(to_unit(value, unit))
+
+
+def _si(value: float | None, factor: float) -> float:
+    """A value read from the file, in SI (None is NaN)."""
+    return float("nan") if value is None else float(value) * factor
+
+
+def _figures_dict(bias: float, stability: dict, units: str) -> dict[str, Any]:
+    return {"bias": to_unit(bias, units),
+            "bias_stability": {f"{p:g} s": to_unit(v, units) for p, v in stability.items()}}
+
+
+def _periods(d: dict[str, Any], names: tuple[str, ...]) -> list[float]:
+    """Averaging periods of the bias stability, s: ``periods_s``, else read off the keys ("10 s")."""
+    if "periods_s" in d:
+        return [float(p) for p in d["periods_s"]]
+    return [float(k.split()[0]) for k in d["figures"][names[0]]["bias_stability"]] if names else []
+
+
+def _read_figures(fig: dict[str, Any], periods: list[float], factor: float) -> dict[str, Any]:
+    values = list(fig["bias_stability"].values())
+    if len(values) != len(periods):
+        raise ValueError(f"{len(values)} bias stabilities for {len(periods)} periods")
+    return {"bias": _si(fig["bias"], factor), "stability": {p: _si(v, factor) for p, v in zip(periods, values)}}
+
+
+def _read_fit(fd: dict[str, Any], tu: tuple[str, ...], result: AllanResult, ci_low: np.ndarray,
+              ci_high: np.ndarray) -> NoiseFit:
+    """A :class:`NoiseFit` from its JSON form; ``dominant`` and ``edf`` are rebuilt when absent."""
+    factors = [parse_unit(t).factor for t in tu]
+    terms = [fd["terms"][t] for t in TERMS]
+    params = np.array([_si(t["value"], k) for t, k in zip(terms, factors)])
+    sigma = np.array([_si(t["sigma"], k) for t, k in zip(terms, factors)])
+    readouts = {key: _si(fd["ieee_point_readouts"][name], factors[k]) for key, (name, _, k) in _READOUTS.items()}
+    if "dominant" in fd:
+        dominant = tuple(fd["dominant"])
+    else:
+        dominant = tuple(TERMS[int(k)] for k in np.argmax(avar_design(result.tau) * params**2, axis=1))
+    if "edf" in fd:
+        edf = np.array(fd["edf"], dtype=float)
+    else:
+        edf = edf_overlapping(result.n_phase, result.m, np.array([NOISE_ALPHA[t] for t in dominant]))
+    return NoiseFit(params, sigma, tuple(bool(t["identifiable"]) for t in terms), tuple(fd.get("notes", ())),
+                    dominant, edf, ci_low, ci_high, readouts)
 
 
 def run_allan(runs: list, fs: float, names: list[str], units: str, grid="dense", per_decade: int = 10,
               modified: bool = False, periods=(1.0, 10.0), progress=None, memory_limit: float = 2e9) -> AllanJob:
     """Allan deviation and fit of the first run, noise figures of every run, the repeatability.
 
-    ``runs`` are raw arrays (n, C) or chunk sources in ``units``; everything is
-    computed on the raw numbers and scaled afterwards (deviations, means and
-    stabilities are linear in the unit), so no SI copy of a large record is made.
+    Parameters
+    ----------
+    runs : list of array_like, shape (n, C), or chunk sources
+        Raw samples in ``units``; everything is computed on the raw numbers and
+        scaled afterwards (deviations, means and stabilities are linear in the
+        unit), so no SI copy of a large record is made.
+    fs : float
+        Sample rate, Hz.
+    names : list of str
+        Channel names, C of them.
+    units : str
+        Unit of the samples (a rate or an acceleration).
+    grid, per_decade, modified, progress, memory_limit : see :func:`align.noise.allan.allan`
+    periods : sequence of float
+        Averaging periods (s) of the bias stability (seed 002 Eq 7).
+
+    Returns
+    -------
+    AllanJob
+        Set its ``inputs`` (and ``plan``) with ``job.replace(...)``.
     """
     factor = parse_unit(units).factor
     # the deviations of the first run; of the others only the bias figures (no kernel pass)
@@ -117,42 +272,66 @@ def run_allan(runs: list, fs: float, names: list[str], units: str, grid="dense",
     return AllanJob(res, fits, figures, rep, units, len(runs))
 
 
-def allan_plot_png(job: AllanJob, target: float | None = None, chosen_tau: float | None = None) -> bytes:
-    """Log-log Allan deviation with its confidence band, the fitted terms, and the planning target."""
-    import io
+def read_runs(paths: list, columns: list[str], rate_hz: float | None = None) -> tuple[list, float]:
+    """Read static recordings of one sensor for :func:`run_allan`, at one common sample rate.
 
-    import matplotlib
+    Parameters
+    ----------
+    paths : list of str or Path
+        ``.csv``, ``.csv.gz``, ``.npy`` or raw float64 ``.bin`` files (see :func:`align.io.read_static`).
+    columns : list of str
+        Data columns, C of them.
+    rate_hz : float, optional
+        Sample rate of files without a time column, Hz.
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    Returns
+    -------
+    runs : list of array_like, shape (n_k, C), or chunk sources
+    fs : float
+        The common sample rate, Hz.
 
-    r, u = job.result, job.units
-    tu = term_units(u)
-    shown = "deg/h" if tu is _GYRO else "ug"
-    fig, ax = plt.subplots(figsize=(7.5, 5))
-    colours = ("tab:red", "tab:green", "tab:blue", "tab:purple", "tab:orange", "tab:brown")
-    for j, (name, f) in enumerate(zip(r.names, job.fits)):
-        c = colours[j % len(colours)]
-        ax.loglog(r.tau, to_unit(r.adev[j], shown), color=c, lw=1.5, label=name)
-        ax.fill_between(r.tau, to_unit(f.ci_low, shown), to_unit(f.ci_high, shown), color=c, alpha=0.2, lw=0)
-        ax.loglog(r.tau, to_unit(model_adev(r.tau, f.params), shown), color=c, lw=0.8, ls="--")
-    f0 = job.fits[0]
-    for k, (t, style) in enumerate(zip(TERMS, (":", "-.", ":", "-.", ":"))):
-        if f0.params[k] > 0:
-            p = np.zeros(5)
-            p[k] = f0.params[k]
-            ax.loglog(r.tau, to_unit(model_adev(r.tau, p), shown), color="0.5", lw=0.8, ls=style)
-            ax.text(r.tau[-1], float(to_unit(model_adev(r.tau[-1:], p)[0], shown)), f" {t}", fontsize=7, color="0.4")
-    if target is not None:
-        ax.axhline(float(to_unit(target, shown)), color="k", lw=1, ls="--", label=f"noise target {float(to_unit(target, shown)):.4g} {shown}")
-    if chosen_tau is not None:
-        ax.axvline(chosen_tau, color="k", lw=1, ls=":", label=f"averaging time {chosen_tau:.4g} s")
-    ax.set_xlabel("averaging time tau [s]")
-    ax.set_ylabel(f"Allan deviation [{shown}]")
-    ax.set_title(f"Overlapping Allan deviation, {r.n:,} samples at {r.fs:g} Hz (band: 68 % CI; dashed: fit)", fontsize=9)
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    return buf.getvalue()
+    Raises
+    ------
+    InputError
+        A run whose sample rate differs from the first run's (named by its file).
+    """
+    from align.io import read_static
+
+    runs, fs = [], None
+    for path in paths:
+        data, f = read_static(path, columns, rate_hz)
+        if fs is not None and abs(f - fs) > 1e-9 * fs:
+            raise InputError(f"sample rate {f:g} Hz differs from the first run's {fs:g} Hz", str(path))
+        runs.append(data)
+        fs = f
+    if fs is None:
+        raise InputError("no recording given", "{paths}")
+    return runs, fs
+
+
+def plan_from_allan(job: AllanJob, rate: float, accuracy: float, noise_ratio: float = 10.0, source: str | None = None,
+                    where: str = "allan result", **common) -> PlanResult:
+    """The test plan (Example 3) from a measured Allan deviation: its worst channel at each tau.
+
+    Parameters
+    ----------
+    job : AllanJob
+        Of gyro data.
+    rate, accuracy, noise_ratio : see :func:`align.noise.planner.make_plan` (rad/s, rad)
+    source : str, optional
+        The noise source as the plan states it; by default "measured curve (worst of x, y, z)".
+    where : str
+        Name of the job (its file) for messages.
+    **common
+        ``turn_angle``, ``steps``, ``settle`` of :func:`~align.noise.planner.make_plan`.
+
+    Raises
+    ------
+    InputError
+        The job holds accelerometer data.
+    """
+    if job.sensor != "gyroscope":
+        raise InputError(f"holds {job.sensor} data ({job.units}); a test plan needs a gyro's", where)
+    r = job.result
+    source = source or f"measured curve (worst of {', '.join(r.names)})"
+    return make_plan(rate, accuracy, noise_ratio, source, tau=r.tau, adev=r.adev.max(axis=0), **common)

@@ -3,25 +3,32 @@
 The noise target for an alignment goal ``psi_T`` at table rate ``w_TR`` with the
 noise ``r`` times below the goal is ``w_TR sin(psi_T) / r`` (100 deg/s, 0.1 deg,
 r = 10: 62.83 deg/h). The shortest averaging time is where the Allan deviation
-(measured, or the model ``N, B, K``) first falls to the target, on its falling
-branch; below the curve's floor no averaging time meets it. For the angle
-method the noise on a turn of duration ``T`` is about ``T sigma(T)`` (the angle
-integrated over ``T``), which must stay below ``Theta sin(psi_T) / r``.
+(measured, or the IEEE model of :mod:`align.noise.model`) first falls to the
+target, on its falling branch; below the curve's floor no averaging time meets
+it. For the angle method the noise on a turn of duration ``T`` is about
+``T sigma(T)`` (the angle integrated over ``T``), which must stay below
+``Theta sin(psi_T) / r``.
 
 Public names
 ------------
-PlanResult, noise_target, model_curve, averaging_time, longest_turn, make_plan
+PlanResult, Averaging, noise_target, model_curve, averaging_time, longest_turn, make_plan, FORMAT
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
 
 import numpy as np
 
-from align.units import DEG_H
+from align.errors import InputError
+from align.noise.model import NoiseModel
+from align.parts import Part
+from align.results import Result, register
+from align.units import DEG, DEG_H
+from align.values import Value
 
-_LN = 2 * np.log(2) / np.pi
+FORMAT = "imu-align.plan"
 
 
 def noise_target(rate: float, accuracy: float, ratio: float = 10.0) -> float:
@@ -29,17 +36,31 @@ def noise_target(rate: float, accuracy: float, ratio: float = 10.0) -> float:
     return float(rate * np.sin(accuracy) / ratio)
 
 
-def model_curve(white: float, flicker: float = 0.0, random_walk: float = 0.0, quantization: float = 0.0):
-    """``sigma(tau)`` of the IEEE model (rad/s) as a function of tau (s)."""
-    def sigma(tau):
-        tau = np.asarray(tau, dtype=float)
-        return np.sqrt(3 * quantization**2 / tau**2 + white**2 / tau + _LN * flicker**2 + random_walk**2 * tau / 3)
-    return sigma
+def model_curve(white: float, flicker: float = 0.0, random_walk: float = 0.0, quantization: float = 0.0) -> NoiseModel:
+    """``sigma(tau)`` of the IEEE model (rad/s) as a function of tau (s).
+
+    The terms in SI: ``white`` N (rad/sqrt(s)), ``flicker`` B (rad/s),
+    ``random_walk`` K (rad/s/sqrt(s)), ``quantization`` Q (rad). Returns the
+    callable :class:`~align.noise.model.NoiseModel` of those terms.
+    """
+    return NoiseModel(quantization=quantization, white=white, flicker=flicker, random_walk=random_walk)
 
 
-@dataclass(frozen=True)
-class Averaging:
-    """Shortest averaging time meeting a target on the falling branch, or why none does."""
+def preset_model(part: Part, where: str = "{imu}") -> tuple[str, NoiseModel]:
+    """The noise model of a datasheet preset: its angle random walk (or noise density) and
+    bias instability, with the label a plan states as its noise source."""
+    n = part.si("arw", "angle_random_walk") or part.si("noise_density", "angle_random_walk")
+    if n is None:
+        raise InputError(f"{part.name} has no angle random walk or noise density in the preset table", where)
+    return f"datasheet preset {part.name}", model_curve(n, part.si("bias_instability", "angular_rate") or 0.0)
+
+
+@dataclass(frozen=True, eq=False)
+class Averaging(Value):
+    """Shortest averaging time meeting a target on the falling branch, or why none does.
+
+    ``tau`` (s, None when infeasible), the curve's ``floor`` (rad/s) at ``floor_tau`` (s), ``reason``.
+    """
 
     tau: float | None
     floor: float
@@ -98,9 +119,33 @@ def longest_turn(angle_target: float, sigma, t_max: float = 1e5) -> float | None
     return float(np.exp(brentq(g, np.log(1e-6), np.log(t_max), xtol=1e-12)))
 
 
-@dataclass(frozen=True)
-class PlanResult:
-    """A test plan from the noise (SI units)."""
+@register
+@dataclass(frozen=True, eq=False)
+class PlanResult(Result):
+    """A test plan from the noise (SI units: rad/s, rad, s).
+
+    Attributes
+    ----------
+    rate : float
+        Table rate, rad/s.
+    accuracy : float
+        Alignment goal, rad.
+    noise_ratio : float
+    noise_target : float
+        ``rate sin(accuracy) / noise_ratio``, rad/s (Example 3).
+    averaging : Averaging
+    turn_angle : float
+        Turn of the angle method, rad.
+    longest_turn : float or None
+        Longest turn duration meeting the angle target, s.
+    steps : int
+    settle : float
+        Settling time added to each step, s.
+    source : str
+        Where the noise curve came from.
+    inputs : dict
+        The inputs, for the record (set with ``replace(inputs=...)``).
+    """
 
     rate: float
     accuracy: float
@@ -112,16 +157,27 @@ class PlanResult:
     steps: int
     settle: float
     source: str
+    inputs: dict = field(default_factory=dict)
 
-    def to_dict(self) -> dict:
-        from align import __version__
+    FORMAT: ClassVar[str] = FORMAT
+    VERSION: ClassVar[int] = 1
+    CONVENTION: ClassVar[str] = ("noise target = rate sin(accuracy) / noise_ratio (Example 3); averaging time: "
+                                 "shortest tau with sigma(tau) <= target on the falling branch of the Allan deviation")
 
-        a = self.averaging
-        dwell = None if a.tau is None else a.tau + self.settle
+    @property
+    def dwell(self) -> float | None:
+        """Averaging time plus settling time per step, s (None when infeasible)."""
+        return None if self.averaging.tau is None else self.averaging.tau + self.settle
+
+    def to_dict(self) -> dict[str, Any]:
+        """The versioned JSON form (deg, deg/s, deg/h, s)."""
+        a, dwell = self.averaging, self.dwell
         return {
-            "format": "imu-align.plan", "version": 1, "generator": f"imu-align {__version__}",
-            "units": {"noise_target_deg_h": "deg/h", "averaging_time_s": "s"},
-            "rate_deg_s": self.rate / np.radians(1), "accuracy_deg": float(np.degrees(self.accuracy)),
+            **self.envelope({"noise_target_deg_h": "deg/h", "averaging_time_s": "s", "rate_deg_s": "deg/s",
+                             "accuracy_deg": "deg", "floor_deg_h": "deg/h", "floor_tau_s": "s",
+                             "turn_angle_deg": "deg", "longest_turn_s": "s", "settle_s": "s", "dwell_s": "s",
+                             "total_table_time_s": "s"}),
+            "rate_deg_s": self.rate / DEG, "accuracy_deg": self.accuracy / DEG,
             "noise_ratio": self.noise_ratio,
             "noise_target_deg_h": self.noise_target / DEG_H,
             "averaging_time_s": a.tau,
@@ -129,10 +185,31 @@ class PlanResult:
             "reason": a.reason,
             "floor_deg_h": a.floor / DEG_H, "floor_tau_s": a.floor_tau,
             "noise_source": self.source,
-            "angle_method": {"turn_angle_deg": float(np.degrees(self.turn_angle)), "longest_turn_s": self.longest_turn},
+            "angle_method": {"turn_angle_deg": self.turn_angle / DEG, "longest_turn_s": self.longest_turn},
             "test_plan": {"steps": self.steps, "settle_s": self.settle, "dwell_s": dwell,
                           "total_table_time_s": None if dwell is None else self.steps * dwell},
+            "inputs": self.inputs,
         }
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any], where: str = "result") -> PlanResult:
+        """Read the form written by :meth:`to_dict`."""
+        cls.check_envelope(d, where)
+        try:
+            am, tp = d["angle_method"], d["test_plan"]
+            tau = d["averaging_time_s"]
+            return cls(
+                rate=float(d["rate_deg_s"]) * DEG, accuracy=float(d["accuracy_deg"]) * DEG,
+                noise_ratio=float(d["noise_ratio"]), noise_target=float(d["noise_target_deg_h"]) * DEG_H,
+                averaging=Averaging(None if tau is None else float(tau), float(d["floor_deg_h"]) * DEG_H,
+                                    float(d["floor_tau_s"]), str(d["reason"])),
+                turn_angle=float(am["turn_angle_deg"]) * DEG,
+                longest_turn=None if am["longest_turn_s"] is None else float(am["longest_turn_s"]),
+                steps=int(tp["steps"]), settle=float(tp["settle_s"]), source=str(d["noise_source"]),
+                inputs=dict(d.get("inputs", {})),
+            )
+        except (KeyError, TypeError, ValueError) as exc:
+            raise InputError(f"malformed {FORMAT} result ({exc!r}); regenerate it", where) from None
 
 
 def make_plan(rate: float, accuracy: float, ratio: float, source: str, tau=None, adev=None, sigma=None,

@@ -17,7 +17,7 @@ wording; an accelerometer works the same in m/s^2):
 
 Public names
 ------------
-NoiseSpec, simulate_noise, simulate_imu, seed_method_a, seed_method_b, seed_restoring
+NoiseSpec, FLICKER_MODELS, simulate_noise, simulate_imu, seed_method_a, seed_method_b, seed_restoring
 """
 
 from __future__ import annotations
@@ -26,10 +26,23 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from align.errors import InputError
+from align.noise.fit import noise_figures
+from align.noise.model import NoiseModel
+from align.values import Value
 
-@dataclass(frozen=True)
-class NoiseSpec:
-    """Noise terms of one sensor axis (SI units; see module docstring)."""
+#: the ways of synthesising flicker noise
+FLICKER_MODELS = ("fft", "gauss-markov")
+
+
+@dataclass(frozen=True, eq=False)
+class NoiseSpec(Value):
+    """Noise terms of one sensor axis (SI units; see module docstring).
+
+    ``quantization``, ``white``, ``flicker``, ``random_walk`` and ``ramp`` are
+    the five terms of :class:`~align.noise.model.NoiseModel` (:attr:`model`),
+    so a simulated record's Allan deviation follows ``spec.model(tau)``.
+    """
 
     bias: float = 0.0
     turn_on: float = 0.0
@@ -40,6 +53,17 @@ class NoiseSpec:
     ramp: float = 0.0
     flicker_model: str = "fft"
     flicker_bank: int = 12
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.flicker_model not in FLICKER_MODELS:
+            raise InputError(f"unknown flicker model {self.flicker_model!r}; use {' or '.join(FLICKER_MODELS)}",
+                             "{flicker_model}")
+
+    @property
+    def model(self) -> NoiseModel:
+        """The five IEEE terms of this spec as a curve ``sigma(tau)``."""
+        return NoiseModel(self.quantization, self.white, self.flicker, self.random_walk, self.ramp)
 
 
 def _rng(seed) -> np.random.Generator:
@@ -89,10 +113,8 @@ def simulate_noise(n: int, fs: float, spec: NoiseSpec, channels: int = 1, seed=0
     if spec.flicker:
         if spec.flicker_model == "fft":
             e = e + _flicker_fft(n, fs, spec.flicker, rng, channels)
-        elif spec.flicker_model == "gauss-markov":
-            e = e + _flicker_gm(n, fs, spec.flicker, rng, channels, spec.flicker_bank)
         else:
-            raise ValueError(f"unknown flicker model {spec.flicker_model!r}")
+            e = e + _flicker_gm(n, fs, spec.flicker, rng, channels, spec.flicker_bank)
     if spec.random_walk:
         e = e + np.cumsum(rng.standard_normal((n, channels)), axis=0) * spec.random_walk * np.sqrt(dt)
     if spec.quantization:
@@ -143,8 +165,6 @@ def seed_restoring(truth: np.ndarray, fs: float, bias: float, repeatability: flo
     sequence is rescaled about its mean so that its bias stability over ``period``
     equals the stated one: ``Q' = Q B_s / B_s(real) + mean(Q) (1 - B_s / B_s(real))``.
     """
-    from align.noise.fit import noise_figures
-
     rng = _rng(seed)
     dt = 1.0 / fs
     n = len(truth)

@@ -15,11 +15,15 @@ from __future__ import annotations
 import base64
 import html
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from align import CONVENTION, __version__
 from align.units import DEG, to_unit
+
+if TYPE_CHECKING:
+    from align.noise import AllanJob, PlanResult
 
 _CSS = """
 body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:1000px;margin:2em auto;padding:0 1em;color:#222}
@@ -145,9 +149,11 @@ def allowance_section(allow, margins=None, basis: str = "rss") -> Section:
     return Section("What the manoeuvre allows", body)
 
 
-def allan_section(allan_dict: dict, plot_png: bytes | None, plan_dict: dict | None) -> Section:
+def allan_section(job: AllanJob | None, plot_png: bytes | None, plan: PlanResult | None) -> Section:
     """Allan deviation, fitted terms and the test plan."""
     body = ""
+    allan_dict = None if job is None else job.to_dict()
+    plan_dict = None if plan is None else plan.to_dict()
     if allan_dict is not None:
         u = allan_dict["units"]
         rows = []

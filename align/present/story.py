@@ -8,7 +8,7 @@ files like any other.
 
 Public names
 ------------
-build_report, demo_inputs, DEMO
+build_report, demo_inputs, run_demo, DEMO_TITLE, DEMO
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ from align.io import read_log, read_static, read_toml, write_bytes, write_csv, w
 from align.units import DEG, DEG_H, parse_quantity as q
 
 DEMO = Path(__file__).with_name("demo")
+DEMO_TITLE = "imu-align demo: ADIS16485 on a vehicle antenna platform"
 
 
 def demo_inputs(out: Path, seed: int = 0) -> dict:
@@ -28,7 +29,7 @@ def demo_inputs(out: Path, seed: int = 0) -> dict:
     from align.model import SensorModel
     from align.noise.sim import NoiseSpec, simulate_noise
     from align.alignment.plan import Plan
-    from align.alignment.simulate import SessionSpec, simulate_session
+    from align.alignment.simulate import SessionSpec, SimulationTruth, simulate_session
     from align.units import to_unit
 
     mount, manoeuvre = out / "mount.toml", out / "manoeuvre.toml"
@@ -53,7 +54,8 @@ def demo_inputs(out: Path, seed: int = 0) -> dict:
     write_csv(log, ["time", "gyro_x", "gyro_y", "gyro_z"], np.column_stack([t, to_unit(g, "deg/s")]))
     write_text(plan_path, plan.to_toml())
     return {"mount": mount, "manoeuvre": manoeuvre, "log": log, "plan": plan_path, "allan": static_path,
-            "allan_rate_hz": 100.0, "allan_columns": "gyro_x,gyro_y,gyro_z", "truth_M": truth.M}
+            "allan_rate_hz": 100.0, "allan_columns": "gyro_x,gyro_y,gyro_z", "truth_M": truth.M,
+            "truth": SimulationTruth(truth, "deg/s", seed, {"log": str(log), "plan": str(plan_path)})}
 
 
 def _npy(arr: np.ndarray) -> bytes:
@@ -70,49 +72,47 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
                  accuracy: str = "0.1 deg", noise_ratio: float = 10.0, monte_carlo: int = 100_000, seed: int = 0,
                  basis: str = "rss", progress=None, title: str = "IMU alignment report") -> tuple[str, str, dict]:
     """Run every job whose inputs are given; return (HTML, summary text, results)."""
-    from mechanics.budget import budget, monte_carlo as run_mc
+    from mechanics.budget import budget
+    from mechanics.montecarlo import monte_carlo as run_mc
     from mechanics.mount import mount_from_dict
     from mechanics.render import assembly_png, histogram_png
 
     import align.present.html as report
-    from align.sensitivity.allowable import allowable, manoeuvre_from_dict, margins
+    from align.sensitivity import allowable, check_margins, manoeuvre_from_dict
 
     inputs = {"mount": (str(mount), Path(mount).read_text()), "manoeuvre": (str(manoeuvre), Path(manoeuvre).read_text())}
     m = mount_from_dict(read_toml(mount), str(mount), Path(mount).parent)
     b = budget(m)
     if monte_carlo:
-        b = type(b)(**{**b.__dict__, "monte_carlo": run_mc(m, monte_carlo, seed, progress=progress)})
+        b = b.replace(monte_carlo=run_mc(m, monte_carlo, seed, progress=progress))
     man = manoeuvre_from_dict(read_toml(manoeuvre), str(manoeuvre), Path(manoeuvre).parent)
     allow = allowable(man)
-    rows = margins(b.elements(basis), allow)
+    table = check_margins(b.elements(basis), allow, basis)
     sections = [report.budget_section(b, histogram_png(b) if monte_carlo else None, assembly_png(m)),
-                report.allowance_section(allow, rows, basis)]
-    results = {"budget": b.to_dict(), "allowable": allow.to_dict(),
-               "check": {"basis": basis, "pass": all(r.ok for r in rows)}}
+                report.allowance_section(allow, table, basis)]
+    results = {"budget": b, "allowable": allow, "check": table}
     lines = [f"budget: source total {b.total / DEG:.4f} deg (Example 1: 1.3043), worst case {b.worst_case / DEG:.4f} deg"
              + (f", Monte Carlo p99.73 any axis {b.monte_carlo.percentiles['99.73'][3] / DEG:.4f} deg" if monte_carlo else ""),
              f"allowance: binding {allow.binding} = {allow.binding_value / DEG:.4f} deg; budget ({basis}) "
-             f"{'PASSES' if results['check']['pass'] else 'FAILS'} the check"]
-    plan_dict = allan_dict = plot = None
+             f"{'PASSES' if table.passed else 'FAILS'} the check"]
+    job = pl = plot = None
     if allan is not None:
-        from align.noise.job import allan_plot_png, run_allan
-        from align.noise.planner import make_plan
+        from align.noise import plan_from_allan, run_allan
+        from align.present.plots import allan_plot_png
 
         names = [c.strip() for c in allan_columns.split(",")]
         data, fs = read_static(allan, names, allan_rate_hz)
         job = run_allan([data], fs, names, allan_units)
-        job = type(job)(**{**job.__dict__, "inputs": [str(allan)]})
-        allan_dict = job.to_dict()
-        pl = make_plan(q(table_rate, "angular_rate", "--rate"), q(accuracy, "angle", "--accuracy"), noise_ratio,
-                       "measured curve (worst channel)", tau=job.result.tau, adev=job.result.adev.max(axis=0))
-        plan_dict = pl.to_dict()
+        pl = plan_from_allan(job, q(table_rate, "angular_rate", "{rate}"), q(accuracy, "angle", "{accuracy}"), noise_ratio,
+                             "measured curve (worst channel)")
+        job = job.replace(inputs=(str(allan),), plan=pl)
         plot = allan_plot_png(job, pl.noise_target, pl.averaging.tau)
         inputs["static record"] = (str(allan), "")
-        results["allan"], results["plan"] = allan_dict, plan_dict
+        results["allan"], results["plan"] = job, pl
         avg = "infeasible" if pl.averaging.tau is None else f"{pl.averaging.tau:.4g} s per step"
         lines.append(f"plan: noise target {pl.noise_target / DEG_H:.2f} deg/h at {table_rate}, {accuracy}: averaging {avg}")
-    sections.append(report.allan_section(allan_dict, plot, plan_dict) if allan is not None else
-                    report.Section("Noise and test planning", "<p>No static record given (--allan).</p>"))
+    sections.append(report.allan_section(job, plot, pl) if allan is not None else
+                    report.Section("Noise and test planning", "<p>No static record given.</p>"))
     if log is not None and plan is not None:
         from align.alignment.job import align
         from align.alignment.plan import Plan
@@ -123,9 +123,31 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
         sections.append(report.alignment_section(r))
         inputs["rate-table log"] = (str(log), "")
         inputs["plan"] = (str(plan), Path(plan).read_text())
-        results["alignment"] = r.to_dict()
+        results["alignment"] = r
         ang = r.angles
         lines.append(f"alignment: psi = {', '.join(f'{v / DEG:.3f}' for v in ang.psi)} deg, "
                      f"sigma(M) <= {np.nanmax(r.sigma_M):.1e}, checks {'all pass' if all(c.status == 'pass' for c in r.checks) else 'with warnings'}")
     sections.insert(0, report.inputs_section(inputs))
     return report.html_report(title, sections), "\n".join(lines), results
+
+
+def run_demo(out: Path, progress=None) -> tuple[str, str, dict]:
+    """The demo: bundled inputs written into ``out``, every job run, the alignment compared with the truth.
+
+    Returns
+    -------
+    page : str
+        The HTML report.
+    summary : str
+        What the demo found, ending with the alignment's largest error against the simulation's truth.
+    results : dict of str to Result
+        The jobs' results and the simulation's truth (``"truth"``), each to be saved as ``<name>.json``.
+    """
+    inp = demo_inputs(out)
+    page, summary, results = build_report(inp["mount"], inp["manoeuvre"], log=inp["log"], plan=inp["plan"],
+                                          allan=inp["allan"], allan_columns=inp["allan_columns"],
+                                          allan_rate_hz=inp["allan_rate_hz"], progress=progress, title=DEMO_TITLE)
+    truth = inp["truth"]
+    error = float(np.abs(results["alignment"].M - truth.model.M).max())
+    summary += f"\nalignment error against the simulation's truth: {error:.1e} (largest element of M)"
+    return page, summary, {**results, "truth": truth}

@@ -1,16 +1,25 @@
 """Readable text summaries of results (pure functions returning strings).
 
+Each function takes a result value and returns the text a command prints; display units
+are the result's file units.
+
 Public names
 ------------
-alignment_summary, matrix_text
+matrix_text, alignment_summary, budget_summary, allowable_summary, margin_summary,
+allan_summary, plan_summary, calibration_summary, magnetometer_summary
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from typing import TYPE_CHECKING
+
 from align.alignment.job import AlignmentResult
 from align.units import DEG, to_unit
+
+if TYPE_CHECKING:
+    from align.noise import AllanJob, PlanResult
 
 
 def matrix_text(m: np.ndarray, sigma: np.ndarray | None = None, digits: int = 6, indent: str = "  ") -> str:
@@ -126,8 +135,9 @@ def margin_summary(rows, basis: str) -> str:
     return "\n".join(lines)
 
 
-def allan_summary(d: dict) -> str:
-    """The table ``imu-align allan`` prints, from the job's JSON form."""
+def allan_summary(job: AllanJob) -> str:
+    """The table ``imu-align allan`` prints (values in the job's file units)."""
+    d = job.to_dict()
     u = d["units"]
     lines = [f"Allan deviation: {d['samples']:,} samples at {d['fs_hz']:g} Hz ({d['samples'] / d['fs_hz'] / 3600:.3g} h), "
              f"{len(d['tau'])} taus, {d['runs']} run(s); {d['sensor']} data in {u['adev']}", ""]
@@ -153,8 +163,9 @@ def allan_summary(d: dict) -> str:
     return "\n".join(lines).rstrip()
 
 
-def plan_summary(d: dict) -> str:
+def plan_summary(plan: PlanResult) -> str:
     """The text ``imu-align plan`` prints."""
+    d = plan.to_dict()
     tp = d["test_plan"]
     lines = [f"Test plan: table rate {d['rate_deg_s']:g} deg/s, alignment goal {d['accuracy_deg']:g} deg, "
              f"noise {d['noise_ratio']:g}x below it ({d['noise_source']})",

@@ -1,271 +1,76 @@
-"""Sensitivity: what misalignment does to a manoeuvre, and how much a requirement allows.
+"""Allowable misalignment: how large each element may be before a manoeuvre's limit is reached.
 
-The response of misaligned gyros to a rotation ``w`` is ``g = M w`` with ``M``
-written in angles (Eq 5-10)::
+Each of the nine elements of ``M`` (Eq 5-10) is raised alone until some output
+of the manoeuvre reaches its limit: by Example 2's closed forms
+``phi_max = asin(E / Theta)`` and ``psi_max = acos(1 - E / Theta)`` (Eq 11-13)
+where they apply, otherwise by root finding on attitude propagation
+(:mod:`align.sensitivity.attitude`). The smallest is the binding element; the
+cone is the largest rigid mounting rotation, in any direction, that meets every
+limit. :func:`check_margins` sets a predicted budget against the allowance.
 
-    g_x = w_x cos(psi_x) + w_y sin(phi_xy) + w_z sin(phi_xz)     (and likewise y, z)
-
-and for a rotation about a fixed axis the integrated outputs obey the same
-matrix, ``theta_G = M theta`` (Eq 11-13). sympy derives the response and its
-Jacobian with respect to each angle (:func:`symbolic`); numbers come from the
-lambdified forms. Manoeuvres that are sequences or rate time series are
-propagated as attitude (quaternions, scipy's convention) with the true and the
-misaligned rates, and compared.
-
-Outputs a requirement can limit: ``x``, ``y``, ``z`` (each gyro's integrated
-angle: the rotation vector of the attitude the gyros report minus the true one;
-for a fixed-axis rotation exactly ``(M - I) theta``, Eq 11-13) and ``azimuth``,
-``elevation``, ``roll`` (Z-Y-X Euler angles of the reported attitude minus the true).
+Results: :class:`Allowable` (``imu-align.allowable``) and :class:`MarginTable`
+(``imu-align.check``), both registered with :mod:`align.results`.
 
 Public names
 ------------
-ELEMENTS, OUTPUTS, symbolic, symbolic_text, matrix_from_angles, response,
-sensitivity, Manoeuvre, manoeuvre_from_dict, output_errors, closed_form_errors, Allowable,
-allowable, Margin, margins
+Allowable, allowable, Margin, margins, MarginTable, check_margins
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
-from functools import lru_cache
+from typing import ClassVar
 
 import numpy as np
 
+from align import CONVENTION
 from align.errors import InputError
-from align.units import DEG, parse_quantity
-
-ELEMENTS = ("psi_x", "psi_y", "psi_z", "phi_xy", "phi_xz", "phi_yx", "phi_yz", "phi_zx", "phi_zy")
-OUTPUTS = ("x", "y", "z", "azimuth", "elevation", "roll")
-_AX = {"x": 0, "y": 1, "z": 2}
-
-
-@dataclass(frozen=True)
-class Symbolic:
-    """The sympy model: ``M`` in angles, ``g = M w``, ``theta_G = M theta`` and the Jacobians."""
-
-    angles: tuple
-    w: object
-    theta: object
-    M: object
-    g: object
-    theta_G: object
-    jacobian: object
+from align.results import Result, register
+from align.sensitivity.attitude import closed_form_errors, output_errors
+from align.sensitivity.manoeuvre import Manoeuvre
+from align.sensitivity.symbolic import ELEMENTS, matrix_from_angles
+from align.units import DEG
+from align.values import Value
 
 
-@lru_cache(maxsize=1)
-def symbolic() -> Symbolic:
-    """Derive Eq 5-13 and their sensitivities with sympy (cached)."""
-    import sympy as sp
-
-    ang = sp.symbols(" ".join(ELEMENTS), real=True)
-    a = dict(zip(ELEMENTS, ang))
-    w = sp.Matrix(sp.symbols("omega_x omega_y omega_z", real=True))
-    th = sp.Matrix(sp.symbols("theta_x theta_y theta_z", real=True))
-    m = sp.Matrix(3, 3, lambda i, j: sp.cos(a[f"psi_{'xyz'[i]}"]) if i == j else sp.sin(a[f"phi_{'xyz'[i]}{'xyz'[j]}"]))
-    g = m * w
-    return Symbolic(ang, w, th, m, g, m * th, g.jacobian(sp.Matrix(ang)))
+def _deg(v: float) -> float | None:
+    """rad -> deg for a file; ``inf`` (unconstrained) as None."""
+    return None if not math.isfinite(v) else v / DEG
 
 
-def symbolic_text(style: str = "pretty") -> str:
-    """Eq 5-10, Eq 11-13 and the sensitivity matrix as text (``pretty``) or LaTeX (``latex``)."""
-    import sympy as sp
-
-    s = symbolic()
-    show = (lambda e: sp.latex(e)) if style == "latex" else (lambda e: sp.pretty(e, use_unicode=False))
-    if style not in ("pretty", "latex"):
-        raise InputError("choose pretty or latex", "--symbolic")
-    return "\n\n".join([
-        "Gyro response g = M w (Eq 5-10):", show(sp.Eq(sp.Symbol("g"), s.g, evaluate=False)),
-        "Integrated, fixed-axis rotation theta_G = M theta (Eq 11-13):", show(sp.Eq(sp.Symbol("theta_G"), s.theta_G, evaluate=False)),
-        f"Sensitivity d g / d ({', '.join(ELEMENTS)}):", show(s.jacobian),
-    ])
+def _rad(v: float | None) -> float:
+    """deg from a file -> rad; None (unconstrained) as ``inf``."""
+    return math.inf if v is None else float(v) * DEG
 
 
-@lru_cache(maxsize=1)
-def _lambdified():
-    import sympy as sp
-
-    s = symbolic()
-    m_fn = sp.lambdify([s.angles], s.M, "numpy")
-    j_fn = sp.lambdify([s.angles, list(s.w)], s.jacobian, "numpy")
-    return m_fn, j_fn
-
-
-def _angle_vector(angles) -> np.ndarray:
-    if isinstance(angles, dict):
-        unknown = set(angles) - set(ELEMENTS)
-        if unknown:
-            raise InputError(f"unknown element(s) {', '.join(sorted(unknown))}; elements are {', '.join(ELEMENTS)}")
-        return np.array([float(angles.get(e, 0.0)) for e in ELEMENTS])
-    return np.asarray(angles, dtype=float).reshape(9)
-
-
-def matrix_from_angles(angles) -> np.ndarray:
-    """``M`` of Eq 5-10 from the nine angles (rad), via the lambdified sympy form."""
-    return np.array(_lambdified()[0](tuple(_angle_vector(angles))), dtype=float)
-
-
-def response(w, angles) -> np.ndarray:
-    """Gyro outputs ``g = M w`` (Eq 5-10); ``w`` of shape (3,) or (n, 3)."""
-    return np.asarray(w, float) @ matrix_from_angles(angles).T
-
-
-def sensitivity(w, angles) -> np.ndarray:
-    """Jacobian ``d g / d angles``, shape (3, 9), at rate ``w`` (3,) (lambdified sympy)."""
-    return np.array(_lambdified()[1](tuple(_angle_vector(angles)), list(np.asarray(w, float))), dtype=float)
-
-
-# --- attitude propagation ---------------------------------------------------------------
-
-def _qmul(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Hamilton product of scalar-last quaternions (scipy's convention), arrays (..., 4)."""
-    px, py, pz, pw = np.moveaxis(p, -1, 0)
-    qx, qy, qz, qw = np.moveaxis(q, -1, 0)
-    return np.stack([pw * qx + px * qw + py * qz - pz * qy,
-                     pw * qy - px * qz + py * qw + pz * qx,
-                     pw * qz + px * qy - py * qx + pz * qw,
-                     pw * qw - px * qx - py * qy - pz * qz], axis=-1)
-
-
-def _attitudes(increments: np.ndarray) -> np.ndarray:
-    """Attitude after each body-frame increment (rotation vectors (n, 3)): R_k = R_(k-1) exp(dtheta_k).
-
-    An inclusive prefix product by doubling (log2 n vectorised steps), scalar-last quaternions.
-    """
-    from scipy.spatial.transform import Rotation
-
-    q = Rotation.from_rotvec(increments).as_quat()
-    step = 1
-    while step < len(q):
-        q = np.concatenate([q[:step], _qmul(q[:-step], q[step:])])
-        step *= 2
-    return q
-
-
-@dataclass(frozen=True)
-class Manoeuvre:
-    """A manoeuvre: body-frame rotation increments and the limits on outputs.
+@register
+@dataclass(frozen=True, eq=False)
+class Allowable(Result):
+    """Allowable misalignment per element of a manoeuvre.
 
     Attributes
     ----------
-    increments : ndarray, shape (n, 3)
-        True body-frame rotation vector of each step (a fixed-axis rotation is
-        one step), rad.
-    limits : dict
-        Output name -> largest allowed error, rad.
-    fixed_axis : bool
-        True when the manoeuvre is one rotation about one coordinate axis (the
-        closed forms of Example 2 apply).
-    description : str
+    allowable : dict
+        Element (:data:`~align.sensitivity.symbolic.ELEMENTS`) -> largest size
+        alone, rad; ``inf`` where no limit is ever reached.
+    method : dict
+        Element -> "closed form" or "numeric (attitude propagation)".
+    binding : str
+        The element with the smallest allowance.
+    binding_value : float
+        Its allowance, rad.
+    cone : float
+        Largest rigid mounting rotation in any direction meeting every limit, rad.
+    cone_direction : ndarray, shape (3,)
+        Unit axis of the tightest such rotation.
+    agreement : dict
+        Closed form against attitude propagation at the binding element, deg
+        (the ``agreement`` of the file).
+    manoeuvre : Manoeuvre
+    inputs : dict
+        Where the inputs came from (set with ``replace(inputs=...)``).
     """
-
-    increments: np.ndarray
-    limits: dict
-    fixed_axis: bool = False
-    description: str = ""
-    segments: tuple = field(default_factory=tuple)
-
-
-def manoeuvre_from_dict(data: dict, where: str = "manoeuvre", base_dir=None) -> Manoeuvre:
-    """Read a manoeuvre (``[[rotation]]`` list or ``[series]`` rate file, and ``[limits]``)."""
-    limits_t = data.get("limits")
-    if not isinstance(limits_t, dict) or not limits_t:
-        raise InputError("missing [limits]: the largest allowed error of each gyro (x, y, z) or output angle", where)
-    limits = {}
-    for name, value in limits_t.items():
-        if name not in OUTPUTS:
-            raise InputError(f"unknown output '{name}'; use {', '.join(OUTPUTS)}", f"{where}: limits.{name}")
-        limits[name] = parse_quantity(value, "angle", f"{where}: limits.{name}")
-        if not limits[name] > 0:
-            raise InputError("a limit must be positive", f"{where}: limits.{name}")
-    rotations, series = data.get("rotation"), data.get("series")
-    if rotations and series:
-        raise InputError("give [[rotation]] steps or a [series], not both", where)
-    if series:
-        return _series(series, limits, where, base_dir)
-    if not isinstance(rotations, list) or not rotations:
-        raise InputError("no [[rotation]] (axis, angle) and no [series]: nothing to analyse", where)
-    inc, segs = [], []
-    for k, r in enumerate(rotations, start=1):
-        here = f"{where}: rotation {k}"
-        if not isinstance(r, dict) or "axis" not in r or "angle" not in r:
-            raise InputError("needs axis (x, y or z) and angle", here)
-        axis = str(r["axis"]).strip().lower()
-        sign = -1.0 if axis.startswith("-") else 1.0
-        if axis.lstrip("+-") not in _AX:
-            raise InputError(f"axis '{r['axis']}' is not x, y or z", f"{here}.axis")
-        angle = parse_quantity(r["angle"], "angle", f"{here}.angle")
-        if angle == 0:
-            raise InputError("angle is zero", f"{here}.angle")
-        u = np.zeros(3)
-        u[_AX[axis.lstrip('+-')]] = sign
-        inc.append(angle * u)
-        segs.append((axis.lstrip("+-"), sign * angle))
-    fixed = len(inc) == 1
-    desc = "; ".join(f"{a} {v / DEG:+g} deg" for a, v in segs)
-    return Manoeuvre(np.array(inc), limits, fixed, desc, tuple(segs))
-
-
-def _series(series: dict, limits: dict, where: str, base_dir) -> Manoeuvre:
-    from pathlib import Path
-
-    from align.io import read_log
-    from align.io import check_log, check_time
-
-    if "file" not in series:
-        raise InputError("missing file = \"rates.csv\"", f"{where}: series.file")
-    path = Path(series["file"])
-    if base_dir is not None and not path.is_absolute():
-        path = Path(base_dir) / path
-    cols = [c.strip() for c in str(series.get("columns", "time,wx,wy,wz")).split(",")]
-    if len(cols) != 4:
-        raise InputError("columns must name time and three rates", f"{where}: series.columns")
-    t, w = read_log(path, cols[1:], str(series.get("units", "deg/s")), cols[0])
-    check_log(t, w, str(path), min_rows=2)
-    check_time(t, str(path), gap=1.5)
-    inc = 0.5 * (w[1:] + w[:-1]) * np.diff(t)[:, None]   # trapezoid increments
-    return Manoeuvre(inc, limits, False, f"rate series {path.name}: {len(t)} samples, {t[-1] - t[0]:.4g} s")
-
-
-def _euler(q: np.ndarray) -> np.ndarray:
-    from scipy.spatial.transform import Rotation
-
-    return Rotation.from_quat(q).as_euler("ZYX")             # azimuth, elevation, roll
-
-
-def output_errors(man: Manoeuvre, m: np.ndarray, history: bool = False) -> dict:
-    """Largest |error| (rad) of every limited output over the manoeuvre, by attitude propagation.
-
-    With ``history`` the full time histories are returned instead (arrays (n,)).
-    """
-    from scipy.spatial.transform import Rotation
-
-    q_true = _attitudes(man.increments)
-    q_meas = _attitudes(man.increments @ np.asarray(m).T)
-    out = {}
-    need = set(man.limits) if not history else set(OUTPUTS)
-    if need & {"x", "y", "z"}:
-        d = Rotation.from_quat(q_meas).as_rotvec() - Rotation.from_quat(q_true).as_rotvec()
-        for name in ("x", "y", "z"):
-            out[name] = d[:, _AX[name]]
-    if need & {"azimuth", "elevation", "roll"}:
-        e = _euler(q_meas) - _euler(q_true)
-        e = (e + np.pi) % (2 * np.pi) - np.pi
-        for k, name in enumerate(("azimuth", "elevation", "roll")):
-            out[name] = e[:, k]
-    if history:
-        return out
-    return {name: float(np.max(np.abs(out[name]))) for name in man.limits}
-
-
-def closed_form_errors(man: Manoeuvre, m: np.ndarray) -> np.ndarray:
-    """Eq 11-13 applied step by step and summed: ``sum_k (M - I) theta_k`` per gyro (rad)."""
-    return (man.increments @ (np.asarray(m) - np.eye(3)).T).sum(axis=0)
-
-
-@dataclass(frozen=True)
-class Allowable:
-    """Allowable misalignment per element (rad; ``inf`` where no requirement is affected)."""
 
     allowable: dict
     method: dict
@@ -275,24 +80,52 @@ class Allowable:
     cone_direction: np.ndarray
     agreement: dict
     manoeuvre: Manoeuvre
+    inputs: dict = field(default_factory=dict)
+
+    FORMAT: ClassVar[str] = "imu-align.allowable"
+    VERSION: ClassVar[int] = 1
+    CONVENTION: ClassVar[str] = CONVENTION + "; M_ii = cos(psi_i), M_ij = sin(phi_ij) (Eq 5-10)"
 
     def to_dict(self) -> dict:
-        from align import CONVENTION, __version__
-
+        """The versioned JSON form, angles in deg (``None`` for unconstrained)."""
         return {
-            "format": "imu-align.allowable", "version": 1, "generator": f"imu-align {__version__}",
-            "convention": CONVENTION + "; M_ii = cos(psi_i), M_ij = sin(phi_ij) (Eq 5-10)",
-            "units": {"angles": "deg"},
+            **self.envelope({"angles": "deg"}),
             "manoeuvre": self.manoeuvre.description,
             "limits_deg": {k: v / DEG for k, v in self.manoeuvre.limits.items()},
-            "allowable_deg": {k: (None if not np.isfinite(v) else v / DEG) for k, v in self.allowable.items()},
-            "method": self.method,
+            "allowable_deg": {k: _deg(v) for k, v in self.allowable.items()},
+            "method": dict(self.method),
             "binding": self.binding,
             "binding_deg": self.binding_value / DEG,
             "cone_deg": self.cone / DEG,
             "cone_worst_direction": self.cone_direction.tolist(),
             "agreement": self.agreement,
+            "manoeuvre_detail": self.manoeuvre.to_dict(),
+            "inputs": dict(self.inputs),
         }
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "result") -> Allowable:
+        """Read the form written by :meth:`to_dict`.
+
+        A file without ``manoeuvre_detail`` (written before it existed) gives a
+        manoeuvre with its description and limits but no increments.
+        """
+        cls.check_envelope(d, where)
+        try:
+            if "manoeuvre_detail" in d:
+                man = Manoeuvre.from_dict(d["manoeuvre_detail"], f"{where}: manoeuvre_detail")
+            else:
+                man = Manoeuvre(np.empty((0, 3)), {k: _rad(v) for k, v in d["limits_deg"].items()},
+                                description=str(d["manoeuvre"]))
+            return cls(
+                allowable={k: _rad(v) for k, v in d["allowable_deg"].items()},
+                method=dict(d["method"]), binding=str(d["binding"]), binding_value=_rad(d["binding_deg"]),
+                cone=_rad(d["cone_deg"]), cone_direction=np.array(d["cone_worst_direction"], float).reshape(3),
+                agreement=dict(d["agreement"]), manoeuvre=man, inputs=dict(d.get("inputs", {})),
+            )
+        except (KeyError, TypeError, ValueError, AttributeError) as exc:
+            raise InputError(f"malformed allowable result ({exc!r}); regenerate it with imu-align allowable",
+                             where) from None
 
 
 def _worst_ratio(man: Manoeuvre, m: np.ndarray) -> float:
@@ -321,11 +154,21 @@ def allowable(man: Manoeuvre, directions: int = 200) -> Allowable:
     """Allowable size of each misalignment element alone, the binding one and the cone.
 
     Each element is raised alone (others zero) until some limit is reached:
-    the closed forms ``asin(E / Theta)`` and ``acos(1 - E / Theta)`` where they
-    apply, otherwise numeric root finding (Brent) on attitude propagation,
-    both signs, up to 90 deg (``inf`` when never reached). The cone is the
-    largest rigid mounting rotation, in any direction (``directions`` points on
-    a sphere), that meets every limit.
+    the closed forms ``asin(E / Theta)`` and ``acos(1 - E / Theta)`` (Example 2,
+    from Eq 11-13) where they apply, otherwise numeric root finding (Brent) on
+    attitude propagation, both signs, up to 90 deg (``inf`` when never
+    reached).
+
+    Parameters
+    ----------
+    man : Manoeuvre
+    directions : int
+        Points on a sphere searched for the cone (the largest rigid mounting
+        rotation, in any direction, that meets every limit).
+
+    Returns
+    -------
+    Allowable
     """
     from scipy.optimize import brentq
 
@@ -393,7 +236,7 @@ def _agreement(man: Manoeuvre, element: str, value: float) -> dict:
     closed = closed_form_errors(man, m)
     prop = output_errors(man, m, history=True)
     return {
-        "element": element, "element_deg": (value / DEG) if np.isfinite(value) else None,
+        "element": element, "element_deg": _deg(value),
         "closed_form_deg": dict(zip("xyz", (closed / DEG).tolist())),
         "propagated_deg": {a: float(prop[a][-1] / DEG) for a in "xyz"},
         "note": ("one fixed-axis rotation: Eq 11-13 is exact" if man.fixed_axis else
@@ -401,9 +244,18 @@ def _agreement(man: Manoeuvre, element: str, value: float) -> dict:
     }
 
 
-@dataclass(frozen=True)
-class Margin:
-    """One element of the budget-versus-allowance check (rad; allowed ``inf`` = unconstrained)."""
+@dataclass(frozen=True, eq=False)
+class Margin(Value):
+    """One element of the budget-versus-allowance check.
+
+    Attributes
+    ----------
+    element : str
+    predicted : float
+        The budget's figure for the element, rad.
+    allowed : float
+        The allowance, rad (``inf``: unconstrained).
+    """
 
     element: str
     predicted: float
@@ -411,6 +263,7 @@ class Margin:
 
     @property
     def margin(self) -> float:
+        """``allowed - predicted``, rad."""
         return self.allowed - self.predicted
 
     @property
@@ -419,8 +272,90 @@ class Margin:
 
 
 def margins(predicted: dict, allow: Allowable) -> list[Margin]:
-    """Element by element: the predicted misalignment against the allowable one."""
+    """Element by element: the predicted misalignment (rad) against the allowable one."""
     missing = [e for e in ELEMENTS if e not in predicted]
     if missing:
         raise ValueError(f"no prediction for {missing}")
     return [Margin(e, float(predicted[e]), float(allow.allowable[e])) for e in ELEMENTS]
+
+
+@register
+@dataclass(frozen=True, eq=False)
+class MarginTable(Result):
+    """The budget against the allowance, element by element (iterates over its rows).
+
+    Attributes
+    ----------
+    basis : str
+        Which budget figure was compared ("rss" or "worst").
+    rows : tuple of Margin
+        One per element, in :data:`~align.sensitivity.symbolic.ELEMENTS` order.
+    inputs : dict
+    """
+
+    basis: str
+    rows: tuple[Margin, ...]
+    inputs: dict = field(default_factory=dict)
+
+    FORMAT: ClassVar[str] = "imu-align.check"
+    VERSION: ClassVar[int] = 1
+    CONVENTION: ClassVar[str] = CONVENTION
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "rows", tuple(self.rows))
+        super().__post_init__()
+
+    def __iter__(self):
+        return iter(self.rows)
+
+    def __len__(self) -> int:
+        return len(self.rows)
+
+    @property
+    def passed(self) -> bool:
+        """Every element within its allowance."""
+        return all(r.ok for r in self.rows)
+
+    @property
+    def failed(self) -> list[str]:
+        """The elements over their allowance."""
+        return [r.element for r in self.rows if not r.ok]
+
+    def to_dict(self) -> dict:
+        """The versioned JSON form, angles in deg (``None`` for unconstrained)."""
+        return {
+            **self.envelope({"angles": "deg"}),
+            "basis": self.basis, "pass": self.passed,
+            "elements": [{"element": r.element, "predicted_deg": r.predicted / DEG, "allowed_deg": _deg(r.allowed),
+                          "margin_deg": _deg(r.margin), "pass": r.ok} for r in self.rows],
+            "inputs": dict(self.inputs),
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "result") -> MarginTable:
+        """Read the form written by :meth:`to_dict`."""
+        cls.check_envelope(d, where)
+        try:
+            rows = tuple(Margin(str(r["element"]), _rad(r["predicted_deg"]), _rad(r["allowed_deg"]))
+                         for r in d["elements"])
+            return cls(str(d["basis"]), rows, dict(d.get("inputs", {})))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise InputError(f"malformed check result ({exc!r}); regenerate it with imu-align check", where) from None
+
+
+def check_margins(budget_elements: dict, allow: Allowable, basis: str) -> MarginTable:
+    """The predicted budget against the allowance, element by element.
+
+    Parameters
+    ----------
+    budget_elements : dict
+        Element -> predicted size, rad (``mechanics.budget.Budget.elements(basis)``).
+    allow : Allowable
+    basis : str
+        The budget figure the prediction is ("rss" or "worst"), recorded in the table.
+
+    Returns
+    -------
+    MarginTable
+    """
+    return MarginTable(basis, tuple(margins(budget_elements, allow)))

@@ -6,14 +6,14 @@ import sys
 
 import numpy as np
 import pytest
+from conftest import truth_model, write_session
 
 from align.alignment.job import AlignmentResult
-from align.model import SensorModel
 from align.alignment.plan import Plan, Step
 from align.alignment.simulate import SessionSpec, simulate_session
-from align.units import DEG, parse_quantity as q
-
-from conftest import truth_model, write_session
+from align.model import SensorModel
+from align.units import DEG
+from align.units import parse_quantity as q
 
 SPEC = SessionSpec(noise_density=q("0.3 deg/sqrt(h)", "angle_random_walk"))
 RATE_PLAN = Plan.standard_rate(100 * DEG)

@@ -1,0 +1,106 @@
+"""Ferraris calibration: six static faces and one turn about each axis, as imucal records it.
+
+The accelerometer comes from the six faces (:func:`~align.calibration.accel.calibrate_accel`,
+by default with the pairwise bias); the gyro from the alignment family's
+estimators on the static faces (bias) and the integrated turns (Eq 31), after
+removing the g-sensitivity ``K_ga`` estimated from the static faces, as
+Ferraris and imucal do (``raw = M w + K_ga a + bias``).
+
+Public names
+------------
+ferraris, sections_from_dict, SECTIONS
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from align.alignment.job import AlignOptions, align
+from align.alignment.plan import Plan, Step
+from align.alignment.segment import Segment
+from align.calibration.accel import FACES, calibrate_accel, face_ups, static_means
+from align.calibration.results import Calibration
+from align.errors import InputError
+from align.units import STANDARD_GRAVITY
+
+#: imucal's section names: the six static faces, then the turns about x, y, z
+SECTIONS = tuple(FACES) + ("x_rot", "y_rot", "z_rot")
+
+
+def _check_sections(sections: dict, n: int) -> None:
+    missing = [k for k in SECTIONS if k not in sections]
+    if missing:
+        raise InputError(f"missing sections {', '.join(missing)} (imucal's names: {', '.join(SECTIONS)})", "{sections}")
+    for name, (a, b) in sections.items():
+        if not 0 <= a < b <= n:
+            raise InputError(f"{a}..{b} is not inside the log's {n} samples", f"{{sections}}: {name}")
+
+
+def _g_sensitivity(gyr: np.ndarray, sections: dict, gravity: float) -> np.ndarray:
+    """``K_ga`` from the faces: column ``i`` is ``(g(+i up) - g(-i up)) / 2g``, (rad/s) per (m/s^2)."""
+    face = {f: gyr[a:b].mean(axis=0) for f, (a, b) in sections.items() if f in FACES}
+    return np.column_stack([(face[f"{a}_p"] - face[f"{a}_a"]) / (2 * gravity) for a in "xyz"])
+
+
+def ferraris(acc: np.ndarray, gyr: np.ndarray, fs: float, sections: dict, turn_angle: float,
+             gravity: float = STANDARD_GRAVITY, acc_units: str = "m/s^2", gyr_units: str = "deg/s",
+             pairwise_bias: bool = True, g_sensitivity: bool = True) -> tuple[Calibration, Calibration]:
+    """A Ferraris session (six faces, one turn about each axis): accelerometer and gyro.
+
+    Parameters
+    ----------
+    acc, gyr : ndarray, shape (n, 3)
+        Readings, SI (m/s^2, rad/s).
+    fs : float
+        Sample rate, Hz.
+    sections : dict of str -> (int, int)
+        imucal's section list: ``x_p``, ``x_a``, ... ``z_a`` (static faces) and
+        ``x_rot``, ``y_rot``, ``z_rot`` (turns), each ``(start, end)`` samples, end exclusive.
+    turn_angle : float
+        Signed angle of each turn about the axis pointing up, rad (imucal: -360 deg).
+    gravity : float
+        Local gravity, m/s^2.
+    acc_units, gyr_units : str
+        Units of the readings, for the results' file form.
+    pairwise_bias : bool
+        Accelerometer bias by Ferraris' pairwise formula (else least squares).
+    g_sensitivity : bool
+        Estimate and remove the gyro's ``K_ga`` from the static faces.
+
+    Returns
+    -------
+    (Calibration, Calibration)
+        The accelerometer and the gyroscope.
+    """
+    _check_sections(sections, len(acc))
+    means = static_means(acc, {f: sections[f] for f in FACES}, 0.05 * gravity / np.median(np.linalg.norm(acc, axis=1)))
+    acc_cal = calibrate_accel(means, face_ups(), gravity, acc_units, pairwise_bias=pairwise_bias)
+    a_true = acc_cal.correct(acc)
+    t = np.arange(len(acc)) / fs
+    g = np.array(gyr, float)
+    kga = None
+    notes = []
+    if g_sensitivity:
+        kga = _g_sensitivity(g, sections, gravity)
+        g = g - a_true @ kga.T
+        notes.append("g-sensitivity K_ga from the static faces ((g(+i up) - g(-i up)) / 2g); it also absorbs the "
+                     "vertical Earth rate, which changes sign between the faces")
+    plan = Plan(tuple(Step(i, 1, angle=turn_angle) for i in range(3)))
+    segs = [Segment(f, "static", *sections[f]) for f in FACES]
+    segs += [Segment(f"{a}_rot", "angle", *sections[f"{a}_rot"], step=i) for i, a in enumerate("xyz")]
+    r = align(t, g, plan, AlignOptions(method="lsq", min_dwell=0.5, scale_tolerance=0.2), segs, gyr_units, "gyroscope")
+    notes += ["gyro: Eq 31 on the integrated turns, bias from the static faces (weighted least squares)",
+              "Earth rate not modelled: its vertical part differs between opposite faces and lands in K_ga (or, "
+              "without it, in the bias); the turns integrate at most 15.04 deg/h times their duration"]
+    residuals = {s.name: np.array(s.residual) for s in r.segments if s.kind == "static"}
+    gyro_cal = Calibration("gyroscope", r.M, r.bias, r.sigma_M, r.sigma_bias, gyr_units, "Ferraris turns, least squares",
+                           residuals, {}, tuple(notes), kga)
+    return acc_cal, gyro_cal
+
+
+def sections_from_dict(raw: dict, where: str = "sections") -> dict[str, tuple[int, int]]:
+    """imucal's section list (``{"x_p": {"start": i, "end": j}, ...}``) as sample ranges."""
+    try:
+        return {str(k): (int(v["start"]), int(v["end"])) for k, v in raw.items()}
+    except (KeyError, TypeError, ValueError, AttributeError):
+        raise InputError("each section needs integer start and end", where) from None

@@ -1,0 +1,208 @@
+"""Calibration values: one sensor's ``[M | b]`` and the file holding a session's sensors.
+
+:class:`Calibration` is one sensor's calibration in the shared convention
+``raw = M true + bias`` (corrected by ``true = M^-1 (raw - bias)``), with its
+1-sigma, the residuals of the positions or faces it was fitted to, held-out
+checks and, for a gyro, the g-sensitivity ``K_ga`` (``raw = M w + K_ga a + bias``).
+:class:`CalibrationSet` is the registered result ``imu-align.calibration``: the
+accelerometer and/or gyroscope of one session and the inputs they came from;
+it also writes the pair as imucal's JSON (:meth:`CalibrationSet.as_imucal`).
+
+Public names
+------------
+Calibration, CalibrationSet, SENSORS, FORMAT, CONVENTION
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import ClassVar
+
+import numpy as np
+
+from align.errors import InputError
+from align.io.export import imucal_dict
+from align.results import Result, register
+from align.units import parse_unit, to_unit
+from align.values import Value, frozen_array
+
+FORMAT = "imu-align.calibration"
+CONVENTION = "raw = M true + bias; true = M^-1 (raw - bias); rows of M are sensor axes"
+#: the sensors a calibration file may hold, in the order they are written
+SENSORS = ("accelerometer", "gyroscope")
+
+
+@dataclass(frozen=True, eq=False)
+class Calibration(Value):
+    """One sensor's calibration (reference section 5).
+
+    Attributes
+    ----------
+    sensor : str
+        ``"accelerometer"`` or ``"gyroscope"``.
+    M : ndarray, shape (3, 3)
+        Dimensionless; row ``i`` is sensor axis ``i`` times its scale factor.
+    bias : ndarray, shape (3,)
+        SI (m/s^2, rad/s) or counts.
+    sigma_M, sigma_bias : ndarray, shape (3, 3) and (3,)
+        1-sigma of ``M`` and ``bias`` (NaN when unknown).
+    units : str
+        File and display unit of the readings (``"m/s^2"``, ``"deg/s"``, ``"counts"``).
+    method : str
+        How it was estimated.
+    residuals, checks : dict of str -> ndarray, shape (3,)
+        Fit residuals and held-out checks (reading minus model), SI.
+    notes : tuple of str
+    g_sensitivity : ndarray, shape (3, 3), optional
+        Gyro ``K_ga``, (rad/s) per (m/s^2).
+    """
+
+    sensor: str
+    M: np.ndarray
+    bias: np.ndarray
+    sigma_M: np.ndarray
+    sigma_bias: np.ndarray
+    units: str
+    method: str
+    residuals: dict = field(default_factory=dict)
+    checks: dict = field(default_factory=dict)
+    notes: tuple = ()
+    g_sensitivity: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        object.__setattr__(self, "residuals", {k: frozen_array(v) for k, v in self.residuals.items()})
+        object.__setattr__(self, "checks", {k: frozen_array(v) for k, v in self.checks.items()})
+        object.__setattr__(self, "notes", tuple(self.notes))
+
+    def to_dict(self) -> dict:
+        """The JSON form: matrices dimensionless, readings in ``self.units``."""
+        u = self.units
+        d = {
+            "sensor": self.sensor, "method": self.method, "convention": CONVENTION,
+            "units": {"M": "1", "bias": u, "residuals": u},
+            "M": self.M.tolist(), "A": np.linalg.inv(self.M).tolist(),
+            "bias": to_unit(self.bias, u).tolist(),
+            "uncertainty": {"level": "1 sigma", "M": self.sigma_M.tolist(), "bias": to_unit(self.sigma_bias, u).tolist()},
+            "residuals": {k: to_unit(v, u).tolist() for k, v in self.residuals.items()},
+            "checks": {k: to_unit(v, u).tolist() for k, v in self.checks.items()},
+            "notes": list(self.notes),
+        }
+        if self.g_sensitivity is not None:
+            d["g_sensitivity"] = (self.g_sensitivity * to_unit(1.0, u)).tolist()
+            d["units"]["g_sensitivity"] = f"{u} per m/s^2"
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "calibration") -> Calibration:
+        """Read the form written by :meth:`to_dict`."""
+        try:
+            u = d["units"]["bias"]
+            f = parse_unit(u, where=f"{where}: units.bias").factor
+            unc = d.get("uncertainty", {})
+            gs = d.get("g_sensitivity")
+            return cls(
+                sensor=d["sensor"], M=np.array(d["M"], float).reshape(3, 3),
+                bias=np.array(d["bias"], float).reshape(3) * f,
+                sigma_M=np.array(unc.get("M", np.full((3, 3), np.nan)), float).reshape(3, 3),
+                sigma_bias=np.array(unc.get("bias", [np.nan] * 3), float).reshape(3) * f,
+                units=u, method=d.get("method", ""),
+                residuals={k: np.array(v, float) * f for k, v in d.get("residuals", {}).items()},
+                checks={k: np.array(v, float) * f for k, v in d.get("checks", {}).items()},
+                notes=tuple(d.get("notes", [])),
+                g_sensitivity=None if gs is None else np.array(gs, float).reshape(3, 3) * f,
+            )
+        except (KeyError, TypeError, ValueError) as exc:
+            raise InputError(f"malformed calibration ({exc!r})", where) from None
+
+    def correct(self, raw: np.ndarray, acc: np.ndarray | None = None) -> np.ndarray:
+        """``true = M^-1 (raw - bias - K_ga acc)``.
+
+        Parameters
+        ----------
+        raw : ndarray, shape (n, 3)
+            Readings, SI (or counts).
+        acc : ndarray, shape (n, 3), optional
+            True specific force, m/s^2, for a gyro with a g-sensitivity.
+
+        Returns
+        -------
+        ndarray, shape (n, 3)
+        """
+        off = self.bias if self.g_sensitivity is None or acc is None else self.bias + acc @ self.g_sensitivity.T
+        return np.linalg.solve(self.M, (np.asarray(raw) - off).T).T
+
+
+@register
+@dataclass(frozen=True, eq=False)
+class CalibrationSet(Result):
+    """The calibration file: one session's accelerometer and/or gyroscope.
+
+    Attributes
+    ----------
+    sensors : dict of str -> Calibration
+        Keys among :data:`SENSORS`.
+    inputs : dict
+        The files and settings the calibration came from.
+    """
+
+    FORMAT: ClassVar[str] = FORMAT
+    VERSION: ClassVar[int] = 1
+    CONVENTION: ClassVar[str] = CONVENTION
+
+    sensors: dict
+    inputs: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        unknown = [k for k in self.sensors if k not in SENSORS]
+        if unknown or not self.sensors:
+            raise ValueError(f"a calibration set holds {' and/or '.join(SENSORS)}, not {unknown or 'nothing'}")
+        object.__setattr__(self, "sensors", {k: self.sensors[k] for k in SENSORS if k in self.sensors})
+        object.__setattr__(self, "inputs", dict(self.inputs))
+
+    def to_dict(self) -> dict:
+        """The versioned JSON form: the envelope, ``inputs``, then one key per sensor."""
+        return {**self.envelope({k: c.units for k, c in self.sensors.items()}), "inputs": self.inputs,
+                **{k: c.to_dict() for k, c in self.sensors.items()}}
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "calibration") -> CalibrationSet:
+        """Read the form written by :meth:`to_dict` (any version up to the current one)."""
+        cls.check_envelope(d, where)
+        sensors = {k: Calibration.from_dict(d[k], f"{where}: {k}") for k in SENSORS if k in d}
+        if not sensors:
+            raise InputError(f"holds no {' or '.join(SENSORS)} calibration", where)
+        inputs = d.get("inputs") or {}
+        if not isinstance(inputs, dict):
+            raise InputError("inputs must be an object", f"{where}: inputs")
+        return cls(sensors, inputs)
+
+    def sensor(self, kind: str | None = None, where: str = "calibration") -> Calibration:
+        """The calibration of one sensor: ``kind``, or the only one the set holds.
+
+        Raises
+        ------
+        InputError
+            ``kind`` is not in the set, or it is None and the set holds both sensors.
+        """
+        held = ", ".join(self.sensors)
+        if kind is None:
+            if len(self.sensors) == 1:
+                return next(iter(self.sensors.values()))
+            raise InputError(f"holds {held}: choose one with {{sensor}}", where)
+        if kind not in self.sensors:
+            raise InputError(f"holds {held}, no {kind} calibration; choose another {{sensor}}", where)
+        return self.sensors[kind]
+
+    def correction(self, sensor: str | None = None, where: str = "calibration") -> Calibration:
+        """The calibration that corrects logs of ``sensor`` (see :meth:`sensor`)."""
+        return self.sensor(sensor, where)
+
+    def as_imucal(self) -> dict:
+        """The pair as imucal's ``FerrarisCalibrationInfo`` JSON (see :func:`align.io.export.imucal_dict`)."""
+        missing = [k for k in SENSORS if k not in self.sensors]
+        if missing:
+            raise InputError(f"imucal's format needs both sensors; this calibration has no {', '.join(missing)}")
+        acc, gyr = self.sensors["accelerometer"], self.sensors["gyroscope"]
+        return imucal_dict(acc.M, acc.bias, gyr.M, gyr.bias, gyr.g_sensitivity)

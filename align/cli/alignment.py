@@ -1,0 +1,154 @@
+"""Commands of the alignment family: ``matrix``, ``apply``, ``simulate``.
+
+Public names
+------------
+matrix, apply, simulate, COMMANDS
+"""
+
+from pathlib import Path
+
+import typer
+
+from align.cli import options as opt
+from align.cli.options import split_columns, value
+from align.cli.paths import check_outputs, save_json
+
+GYRO_COLUMNS = "time,gyro_x,gyro_y,gyro_z"
+#: the columns ``apply`` reads by default, per sensor
+SENSOR_COLUMNS = {"gyroscope": GYRO_COLUMNS, "accelerometer": "time,acc_x,acc_y,acc_z",
+                  "magnetometer": "time,mag_x,mag_y,mag_z"}
+
+Log = opt.Arg("Gyro log: .csv, .csv.gz, .npy or .parquet.", "LOG")
+
+
+def matrix(
+    log: Log,
+    plan: opt.Input("--plan", "Test plan TOML: [[step]] tables with axis and rate or angle.", "PLAN.toml"),
+    method: opt.Choice("--method", ("auto", "rate", "angle", "lsq", "two-axis"),
+                   "Estimator; auto: lsq for three turned axes, two-axis for two.") = "auto",
+    gyro_units: opt.GyroUnits() = "deg/s",
+    columns: opt.Columns("Column names: time,x,y,z (x,y,z with --rate-hz).") = GYRO_COLUMNS,
+    rate_hz: opt.RateHz() = None,
+    segments: opt.OptInput("--segments", "Explicit segments JSON {name: {start, end}} instead of automatic.",
+                       "SEGMENTS.json") = None,
+    json_out: opt.JsonOut = None,
+    c_header: opt.OptInput("--c-header", "Write A and the bias as a C header here.", "FILE.h") = None,
+    gyro_range: opt.OptQuantity("--gyro-range", "angular_rate", "Gyro full scale, e.g. '2000 deg/s': flags saturation.",
+                            "RATE") = None,
+    min_dwell: opt.Quantity("--min-dwell", "time", "Shortest acceptable step.", "TIME") = "1 s",
+    window: opt.Quantity("--window", "time", "Moving-mean window of the segmentation.", "TIME") = "0.1 s",
+    margin: opt.Quantity("--margin", "time", "Trimmed from each end of a dwell beyond the ramp.", "TIME") = "0.1 s",
+    static_threshold: opt.Quantity("--static-threshold", "angular_rate",
+                               "Static periods lie within this of the quietest one (angle plans).", "RATE") = "1 deg/s",
+    rate_tolerance: opt.Quantity("--rate-tolerance", "dimensionless", "Largest difference of a measured turn from the plan.",
+                             "RATIO") = "10 %",
+    scale_tolerance: opt.Quantity("--scale-tolerance", "dimensionless", "Scale factors must lie within 1 +/- this.",
+                              "RATIO") = "5 %",
+    axis_to_axis: opt.Quantity("--axis-to-axis", "angle", "Axis-to-axis spec for the two-axis shortcut's error.",
+                           "ANGLE") = "0.05 deg",
+    two_axis_variant: opt.Choice("--two-axis-variant", ("procrustes", "cross"),
+                             "Two-axis shortcut: procrustes, or cross (the source's Eq 36).") = "procrustes",
+    earth: opt.Flag("--earth/--no-earth", "Correct the vertical Earth rate when the plan gives a latitude.") = True,
+) -> None:
+    """Alignment matrix M and A = M^-1 from rate-table data."""
+    check_outputs([log, plan, segments], json_out=json_out, c_header=c_header)
+    import align.io as fileio
+    from align.alignment.job import AlignOptions, align
+    from align.alignment.plan import Plan
+    from align.alignment.segment import SegmentOptions, segments_from_ranges
+    from align.present.text import alignment_summary
+
+    time_col, cols = split_columns(columns, rate_hz)
+    the_plan = Plan.from_dict(fileio.read_toml(plan), str(plan))
+    t, g = fileio.read_log(log, cols, gyro_units, time_col, rate_hz)
+    opts = AlignOptions(method=value(method), two_axis_variant=value(two_axis_variant), axis_to_axis=axis_to_axis,
+                        segmentation=SegmentOptions(window_s=window, margin_s=margin, static_threshold=static_threshold),
+                        min_dwell=min_dwell, rate_tolerance=rate_tolerance, scale_tolerance=scale_tolerance,
+                        gyro_range=gyro_range, earth_correction=earth)
+    segs = None if segments is None else segments_from_ranges(fileio.read_json(segments), the_plan, len(t), str(segments))
+    result = align(t, g, the_plan, opts, segs, gyro_units, str(log))
+    result = result.replace(inputs={"log": str(log), "plan": str(plan), "gyro_units": gyro_units, "columns": columns,
+                                    "segments": None if segments is None else str(segments)})
+    typer.echo(alignment_summary(result))
+    if json_out is not None:
+        save_json(json_out, result)
+    if c_header is not None:
+        fileio.write_text(c_header, result.as_c_header(f"imu-align alignment from {log.name}"))
+
+
+def apply(
+    log: opt.Arg("Log to correct.", "LOG"),
+    alignment: opt.Input("--alignment", "A result of 'matrix', 'calibrate ferraris', 'calibrate accel' or 'calibrate mag'.",
+                     "RESULT.json"),
+    out: opt.Input("--out", "Corrected CSV (same columns and units).", "OUT.csv"),
+    sensor: opt.Choice("--sensor", ("accelerometer", "gyroscope"), "The sensor to correct, for a file holding both.") = None,
+    gyro_units: opt.GyroUnits() = "deg/s",
+    units: opt.Units("Unit of the columns for an accelerometer or magnetometer result (default: the result's).") = None,
+    columns: opt.Columns("Column names: time,x,y,z (x,y,z with --rate-hz); default per sensor.", optional=True) = None,
+    rate_hz: opt.RateHz() = None,
+) -> None:
+    """Correct a log: gyro w = A (g - b); accelerometer M^-1 (a - b); magnetometer soft_iron (m - hard_iron)."""
+    check_outputs([log, alignment], out=out)
+    import numpy as np
+
+    import align.io as fileio
+    from align.results import load_result
+    from align.units import parse_unit, to_unit
+
+    correction = load_result(alignment).correction(value(sensor), str(alignment))
+    kind = correction.sensor
+    if units:
+        u, where = units, "{units}"
+    elif kind == "gyroscope":
+        u, where = gyro_units, "{gyro_units}"
+    else:
+        u, where = correction.units, f"{alignment}: units"
+    expect = "angular_rate" if kind == "gyroscope" else None
+    parse_unit(u, expect, where)
+    time_col, cols = split_columns(columns or SENSOR_COLUMNS[kind], rate_hz)
+    t, raw = fileio.read_log(log, cols, u, time_col, rate_hz, expect=expect)
+    names = ([time_col] if time_col else []) + cols
+    fileio.write_csv(out, names, np.column_stack(([t] if time_col else []) + [to_unit(correction.correct(raw), u)]))
+    typer.echo(f"wrote {out}: {len(t)} rows of {kind} data corrected with {alignment} ({u})")
+
+
+def simulate(
+    out_dir: opt.Arg("Folder for session.csv, plan.toml and truth.json (created if missing).", "OUT_DIR"),
+    plan: opt.OptInput("--plan", "Plan to run ([[step]] tables); default the six-dwell +/- rate plan.", "PLAN.toml") = None,
+    kind: opt.Choice("--kind", ("rate", "angle"), "The default plan's kind.") = "rate",
+    rate: opt.Quantity("--rate", "angular_rate", "Table rate of the default rate plan.", "RATE") = "100 deg/s",
+    angle: opt.Quantity("--angle", "angle", "Turn of the default angle plan.", "ANGLE") = "360 deg",
+    rate_hz: opt.RateHz("Sample rate.") = "200 Hz",
+    dwell: opt.Quantity("--dwell", "time", "Constant-rate part of each rate step.", "TIME") = "10 s",
+    gap: opt.Quantity("--gap", "time", "Static gap between steps.", "TIME") = "3 s",
+    noise: opt.Quantity("--noise", "angle_random_walk", "Angle random walk (white rate noise).", "ARW") = "0.3 deg/sqrt(h)",
+    bias_walk: opt.Quantity("--bias-walk", "rate_random_walk", "Rate random walk of the bias.", "RRW") = "0 deg/h/sqrt(h)",
+    misalignment: opt.Quantity("--misalignment", "angle", "Size of the random mounting rotation.", "ANGLE") = "0.5 deg",
+    seed: opt.Seed = 0,
+    gyro_units: opt.GyroUnits("Unit of the written gyro columns.") = "deg/s",
+) -> None:
+    """Simulate a rate-table session with known M (for rehearsals and examples)."""
+    names = ("session.csv", "plan.toml", "truth.json")
+    check_outputs([plan], folder=("out_dir", out_dir, names))
+    import numpy as np
+
+    import align.io as fileio
+    from align.alignment.plan import Plan
+    from align.alignment.simulate import SessionSpec, SimulationTruth, random_model, simulate_session
+    from align.units import to_unit
+
+    if plan is not None:
+        the_plan = Plan.from_dict(fileio.read_toml(plan), str(plan))
+    else:
+        the_plan = Plan.standard_rate(rate) if value(kind) == "rate" else Plan.standard_angle(angle)
+    rng = np.random.default_rng(seed)
+    truth = random_model(rng, misalignment)
+    spec = SessionSpec(fs=rate_hz, dwell_s=dwell, static_s=gap, noise_density=noise, bias_walk=bias_walk)
+    t, g, _ = simulate_session(the_plan, truth, spec, rng)
+    fileio.write_csv(out_dir / names[0], GYRO_COLUMNS.split(","), np.column_stack([t, to_unit(g, gyro_units)]))
+    fileio.write_text(out_dir / names[1], the_plan.to_toml())
+    save_json(out_dir / names[2], SimulationTruth(truth, gyro_units, seed))
+    typer.echo(f"wrote {out_dir}/session.csv ({len(t)} rows, {t[-1]:.1f} s), plan.toml and truth.json")
+
+
+COMMANDS = {"matrix": matrix, "apply": apply, "simulate": simulate}

@@ -1,0 +1,134 @@
+"""``imu-align calibrate``: Ferraris sessions, accelerometer positions, magnetometer ellipsoid.
+
+Public names
+------------
+app, ferraris, accel, mag, COMMANDS
+"""
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from align.cli import options as opt
+from align.cli.options import names, split_columns, value
+from align.cli.paths import check_outputs, save_json
+
+Gravity = "Local gravity"
+
+
+def ferraris(
+    log: opt.Arg("Session log (CSV) with accelerometer and gyro columns.", "LOG"),
+    sections: opt.Input("--sections", "imucal section list JSON: x_p ... z_a, x_rot, y_rot, z_rot.", "SECTIONS.json"),
+    rate_hz: opt.RateHz("Sample rate.", required=True),
+    turn_angle: opt.Quantity("--turn-angle", "angle", "Signed angle of each turn about the axis pointing up.",
+                         "ANGLE") = "-360 deg",
+    gravity: opt.Quantity("--gravity", "acceleration", Gravity + ".", "ACCEL") = "9.80665 m/s^2",
+    accel_columns: opt.Columns("Accelerometer columns.", "--accel-columns") = "acc_x,acc_y,acc_z",
+    gyro_columns: opt.Columns("Gyro columns.", "--gyro-columns") = "gyr_x,gyr_y,gyr_z",
+    accel_units: opt.UnitFlag("--accel-units", "Accelerometer unit.") = "m/s^2",
+    gyro_units: opt.GyroUnits("Gyro unit.") = "deg/s",
+    bias: opt.Choice("--bias", ("pairwise", "lsq"), "Accelerometer bias: pairwise (Ferraris, tilt-robust) or lsq.") = "pairwise",
+    g_sensitivity: opt.Flag("--g-sensitivity/--no-g-sensitivity",
+                        "Estimate the gyro's g-sensitivity from the static faces.") = True,
+    json_out: opt.JsonOut = None,
+    imucal_json: opt.OptInput("--imucal-json", "Also write the result as imucal's JSON.", "FILE.json") = None,
+) -> None:
+    """A Ferraris session (six static faces and a turn about each axis), as imucal records it."""
+    check_outputs([log, sections], json_out=json_out, imucal_json=imucal_json)
+    import align.io as fileio
+    from align.calibration import CalibrationSet, sections_from_dict
+    from align.calibration import ferraris as compute
+    from align.present.text import calibration_summary
+
+    _, acc = fileio.read_log(log, names(accel_columns), accel_units, None, rate_hz, expect="acceleration")
+    _, gyr = fileio.read_log(log, names(gyro_columns), gyro_units, None, rate_hz)
+    acc_cal, gyr_cal = compute(acc, gyr, rate_hz, sections_from_dict(fileio.read_json(sections), str(sections)), turn_angle, gravity, accel_units, gyro_units,
+                               pairwise_bias=value(bias) == "pairwise", g_sensitivity=g_sensitivity)
+    result = CalibrationSet({"accelerometer": acc_cal, "gyroscope": gyr_cal},
+                            {"log": str(log), "sections": str(sections)})
+    typer.echo(calibration_summary(result.sensors))
+    if json_out is not None:
+        save_json(json_out, result)
+    if imucal_json is not None:
+        fileio.write_json(imucal_json, result.as_imucal())
+
+
+def accel(
+    log: opt.Arg("Accelerometer log: static positions separated by moves.", "LOG"),
+    positions: opt.OptInput("--positions", "Positions TOML ([[position]] tables: up, start/end, holdout); without it the "
+                        "orientations are unknown and |a| = g is fitted.", "POSITIONS.toml") = None,
+    columns: opt.Columns("Columns: time,x,y,z (x,y,z with --rate-hz).") = "time,acc_x,acc_y,acc_z",
+    rate_hz: opt.RateHz() = None,
+    accel_units: opt.UnitFlag("--accel-units", "Unit of the readings (an acceleration, or 'counts').") = "m/s^2",
+    gravity: Annotated[str | None, typer.Option("--gravity", metavar="ACCEL", help=(
+        Gravity + " (default 9.80665 m/s^2, or the positions file's gravity)."))] = None,
+    window: opt.Quantity("--window", "time", "Variance window of the static detector.", "TIME") = "1 s",
+    factor: Annotated[float, typer.Option("--factor", help="Static threshold: this many times the quiet variance.")] = 6.0,
+    init_static: opt.OptQuantity("--init-static", "time", "Initial static period for the threshold (imu_tk), e.g. '50 s'.",
+                             "TIME") = None,
+    min_static: opt.Quantity("--min-static", "time", "Shortest static interval.", "TIME") = "1 s",
+    json_out: opt.JsonOut = None,
+) -> None:
+    """Accelerometer multi-position calibration (known orientations, or |a| = g over many attitudes)."""
+    check_outputs([log, positions], json_out=json_out)
+    import align.io as fileio
+    from align.calibration import CalibrationSet, StaticDetector, calibrate_accel_log
+    from align.present.text import calibration_summary
+    from align.units import parse_quantity, parse_unit
+
+    time_col, cols = split_columns(columns, rate_hz)
+    counts = parse_unit(accel_units, where="{accel_units}").dim == parse_unit("counts").dim
+    t, a = fileio.read_log(log, cols, accel_units, time_col, rate_hz, expect="counts" if counts else "acceleration")
+    spec = fileio.read_toml(positions) if positions is not None else None
+    g = None if gravity is None else parse_quantity(gravity, "acceleration", "{gravity}")
+    cal = calibrate_accel_log(t, a, spec, accel_units, g, StaticDetector(window, factor, init_static, min_static), str(log),
+                              str(positions))
+    result = CalibrationSet({"accelerometer": cal}, {"log": str(log),
+                                                     "positions": None if positions is None else str(positions)})
+    typer.echo(calibration_summary(result.sensors))
+    if json_out is not None:
+        save_json(json_out, result)
+
+
+def mag(
+    log: opt.Arg("Magnetometer capture while tumbling the device (CSV or blank-separated text).", "LOG"),
+    columns: opt.Columns("Magnetometer columns (col0,col1,... for a file without header).") = "mag_x,mag_y,mag_z",
+    mag_units: opt.UnitFlag("--mag-units", "Unit: uT, nT, gauss, mG, 'counts', or the size of one count, e.g. "
+                        "'0.92 mG'.") = "uT",
+    field: Annotated[str | None, typer.Option("--field", metavar="FIELD", help=(
+        "Known field strength to refine to, e.g. '48.5 uT'."))] = None,
+    model: opt.Choice("--model", ("sphere", "diagonal", "symmetric"), "Soft-iron model.") = "symmetric",
+    accel_columns: opt.Columns("Simultaneous accelerometer columns (dip angle, alignment to gravity).", "--accel-columns",
+                           optional=True) = None,
+    dip: opt.OptQuantity("--dip", "angle", "Magnetic dip for the heading-error prediction when no accelerometer.",
+                     "ANGLE") = None,
+    json_out: opt.JsonOut = None,
+) -> None:
+    """Magnetometer hard and soft iron (ellipsoid fit with coverage gates)."""
+    check_outputs([log], json_out=json_out)
+    import align.io as fileio
+    from align.calibration import calibrate_magnetometer, with_gravity_alignment
+    from align.present.text import magnetometer_summary
+    from align.units import parse_quantity, parse_scale
+
+    scale, shown = parse_scale(mag_units, "magnetic_field", "{mag_units}")
+    _, data = fileio.read_columns(log, names(columns) + (names(accel_columns) if accel_columns else []))
+    m = data[:, :3] * scale
+    acc = data[:, 3:6] if accel_columns else None
+    f = None if field is None else parse_quantity(field, "counts" if shown == "counts" else "magnetic_field", "{field}")
+    cal = calibrate_magnetometer(m, shown, f, value(model), acc, dip)
+    if acc is not None:
+        cal = with_gravity_alignment(cal, m, acc)
+    cal = cal.replace(inputs={"log": str(log), "columns": columns, "mag_units": mag_units})
+    typer.echo(magnetometer_summary(cal))
+    if json_out is not None:
+        save_json(json_out, cal)
+
+
+COMMANDS = {"ferraris": ferraris, "accel": accel, "mag": mag}
+
+app = typer.Typer(help="Sensor calibration: Ferraris sessions, accelerometer positions, magnetometer ellipsoid.",
+                  add_completion=False, rich_markup_mode=None, pretty_exceptions_enable=False)
+for _name, _command in COMMANDS.items():
+    app.command(_name)(_command)

@@ -1,0 +1,122 @@
+"""Commands of the mounting budget and the allowance: ``budget``, ``allowable``, ``check``.
+
+Public names
+------------
+budget, allowable, check, COMMANDS, MOUNT_HELP, MANOEUVRE_HELP
+"""
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from align.cli import options as opt
+from align.cli.options import value
+from align.cli.paths import check_outputs, save_json
+from align.cli.progress import progress
+
+MOUNT_HELP = "Mount description TOML: [imu], [package], [ledges] or [baseplate], [screws]."
+MANOEUVRE_HELP = "Manoeuvre TOML: [[rotation]] tables with axis and angle (or a [series]), and [limits]."
+Mount = opt.Arg(MOUNT_HELP, "MOUNT")
+Manoeuvre = opt.Arg(MANOEUVRE_HELP, "MANOEUVRE")
+
+
+def _read_mount(path: Path):
+    from align.io import read_toml
+    from mechanics import mount_from_dict
+
+    return mount_from_dict(read_toml(path), str(path), path.parent)
+
+
+def _read_manoeuvre(path: Path):
+    from align.io import read_toml
+    from align.sensitivity import manoeuvre_from_dict
+
+    return manoeuvre_from_dict(read_toml(path), str(path), path.parent)
+
+
+def budget(
+    mount: Mount,
+    monte_carlo: opt.MonteCarlo() = 0,
+    seed: opt.Seed = 0,
+    json_out: opt.JsonOut = None,
+    plot: opt.OptInput("--plot", "PNG histogram of the Monte Carlo (needs --monte-carlo).", "FILE.png") = None,
+    picture: opt.OptInput("--picture", "PNG of the assembly, tilt exaggerated.", "FILE.png") = None,
+    glb: opt.OptInput("--glb", "GLB of the assembly, tilt exaggerated.", "FILE.glb") = None,
+    exaggerate: Annotated[float, typer.Option("--exaggerate", help="Angle exaggeration of --picture and --glb.")] = 30.0,
+) -> None:
+    """Mounting-misalignment budget: source formulas, worst case and Monte Carlo."""
+    from align.errors import InputError
+
+    if plot is not None and monte_carlo == 0:
+        raise InputError("the histogram needs {monte_carlo}", "{plot}")
+    check_outputs([mount], json_out=json_out, plot=plot, picture=picture, glb=glb)
+    import mechanics
+    from align.io import write_bytes
+    from align.present.text import budget_summary
+
+    m = _read_mount(mount)
+    result = mechanics.budget(m)
+    if monte_carlo:
+        with progress(monte_carlo, "Monte Carlo") as tick:
+            result = result.replace(monte_carlo=mechanics.monte_carlo(m, monte_carlo, seed, progress=tick))
+    pictures = []  # drawn before anything is written
+    if plot is not None:
+        pictures.append((plot, mechanics.histogram_png(result)))
+    if picture is not None:
+        pictures.append((picture, mechanics.assembly_png(m, exaggerate)))
+    if glb is not None:
+        pictures.append((glb, mechanics.assembly_glb(m, exaggerate)))
+    typer.echo(budget_summary(result))
+    if json_out is not None:
+        save_json(json_out, result)
+    for path, data in pictures:
+        write_bytes(path, data)
+
+
+def allowable(
+    manoeuvre: Manoeuvre,
+    json_out: opt.JsonOut = None,
+    symbolic: opt.Choice("--symbolic", ("pretty", "latex"), "Also print the sympy response and sensitivity.") = None,
+) -> None:
+    """Allowable misalignment per element for a manoeuvre, the binding element and the cone."""
+    check_outputs([manoeuvre], json_out=json_out)
+    from align.present.text import allowable_summary
+    from align.sensitivity import allowable as compute
+    from align.sensitivity import symbolic_text
+
+    man = _read_manoeuvre(manoeuvre)
+    if symbolic is not None:
+        typer.echo(symbolic_text(value(symbolic)) + "\n")
+    result = compute(man)
+    typer.echo(allowable_summary(result))
+    if json_out is not None:
+        save_json(json_out, result)
+
+
+def check(
+    mount: Mount,
+    manoeuvre: Manoeuvre,
+    basis: opt.Choice("--basis", ("rss", "worst"), "Budget figure to compare: rss (the source's method) or worst.") = "rss",
+    json_out: opt.JsonOut = None,
+) -> None:
+    """The mounting budget against the allowance; exit status 4 when an element fails."""
+    check_outputs([mount, manoeuvre], json_out=json_out)
+    import mechanics
+    from align.errors import CheckFailed
+    from align.present.text import margin_summary
+    from align.sensitivity import allowable as compute
+    from align.sensitivity import check_margins
+
+    b = mechanics.budget(_read_mount(mount))
+    allow = compute(_read_manoeuvre(manoeuvre))
+    table = check_margins(b.elements(value(basis)), allow, value(basis))
+    table = table.replace(inputs={"mount": str(mount), "manoeuvre": str(manoeuvre)})
+    typer.echo(margin_summary(table.rows, table.basis))
+    if json_out is not None:
+        save_json(json_out, table)
+    if not table.passed:
+        raise CheckFailed(f"the budget ({table.basis}) exceeds the allowance for {', '.join(table.failed)}")
+
+
+COMMANDS = {"budget": budget, "allowable": allowable, "check": check}

@@ -1,0 +1,155 @@
+"""Commands of the noise family: ``allan`` (Allan deviation and fit) and ``plan`` (averaging time).
+
+Public names
+------------
+allan, plan, COMMANDS
+"""
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from align.cli import options as opt
+from align.cli.options import names
+from align.cli.paths import check_outputs, save_json
+from align.cli.progress import progress
+
+GRIDS = ("dense", "octave", "decade")
+
+
+def grid_value(text: str) -> str | list[float]:
+    """``dense``, ``octave``, ``decade`` or a comma list of taus in seconds."""
+    if text in GRIDS:
+        return text
+    try:
+        taus = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise ValueError(f"'{text}' is not dense, octave, decade or a comma list of taus in seconds") from None
+    if not taus or min(taus) <= 0:
+        raise ValueError("taus must be positive seconds")
+    return taus
+
+
+NoiseRatio = Annotated[float, typer.Option("--noise-ratio", help="Plan for noise this many times below the goal.")]
+Accuracy = "Alignment goal, e.g. '0.1 deg'"
+
+
+def allan(
+    logs: Annotated[list[Path], typer.Argument(metavar="LOG...", show_default=False, help=(
+        "Static recordings: .csv, .csv.gz, .npy or raw float64 .bin; several runs give the bias repeatability."))],
+    columns: opt.Columns("Data columns (a CSV's time column is 'time' unless --rate-hz).") = "gyro_x,gyro_y,gyro_z",
+    rate_hz: opt.RateHz("Sample rate, for files without a time column (.npy always).") = None,
+    gyro_units: opt.GyroUnits("Unit of the data columns (an angular rate).") = "deg/s",
+    units: opt.Units("Any rate or acceleration unit instead of --gyro-units (e.g. g).") = None,
+    grid: Annotated[str, typer.Option("--grid", parser=grid_value, metavar="GRID",
+                                      help="dense | octave | decade | explicit taus '0.01,0.1,1' (s).")] = "dense",
+    per_decade: Annotated[int, typer.Option("--per-decade", min=1, help="Points per decade of the dense grid.")] = 10,
+    modified: Annotated[bool, typer.Option("--modified", help="Also the modified Allan deviation.")] = False,
+    json_out: opt.JsonOut = None,
+    plot: opt.OptInput("--plot", "Log-log plot with confidence band and fit (PNG).", "FILE.png") = None,
+    rate: opt.OptQuantity("--rate", "angular_rate", "Table rate, to plan: draws the target and the averaging time.",
+                      "RATE") = None,
+    accuracy: opt.OptQuantity("--accuracy", "angle", Accuracy + ", to plan (with --rate).", "ANGLE") = None,
+    noise_ratio: NoiseRatio = 10.0,
+    memory_limit_mb: Annotated[float, typer.Option("--memory-limit-mb", help=(
+        "Phase kept in memory up to this size; beyond it, a temporary file."))] = 2000.0,
+) -> None:
+    """Allan deviation, noise-model fit and noise figures of static recordings."""
+    from align.errors import InputError
+
+    if (rate is None) != (accuracy is None):
+        raise InputError("give both {rate} and {accuracy} to plan", "{rate}" if rate is None else "{accuracy}")
+    check_outputs(logs, json_out=json_out, plot=plot)
+    from align.noise import plan_from_allan, read_runs, run_allan
+    from align.present.text import allan_summary, plan_summary
+    from align.units import parse_unit
+
+    unit = units or gyro_units
+    parse_unit(unit, None if units else "angular_rate", "{units}" if units else "{gyro_units}")
+    if units and parse_unit(units).dim not in (parse_unit("rad/s").dim, parse_unit("m/s^2").dim):
+        raise InputError(f"'{units}' is neither an angular rate nor an acceleration", "{units}")
+    channels = names(columns)
+    runs, fs = read_runs(logs, channels, rate_hz)
+    with progress(runs[0].shape[0], "Allan deviation (samples read)") as tick:
+        job = run_allan(runs, fs, channels, unit, grid, per_decade, modified, progress=tick,
+                        memory_limit=memory_limit_mb * 1e6)
+    job = job.replace(inputs=tuple(str(p) for p in logs))
+    if rate is not None:
+        job = job.replace(plan=plan_from_allan(job, rate, accuracy, noise_ratio, "measured curve (worst channel)"))
+    typer.echo(allan_summary(job))
+    if job.plan is not None:
+        typer.echo("\n" + plan_summary(job.plan))
+    png = None
+    if plot is not None:
+        from align.present.plots import allan_plot_png
+
+        png = allan_plot_png(job, *((job.plan.noise_target, job.plan.averaging.tau) if job.plan else ()))
+    if json_out is not None:
+        save_json(json_out, job)
+    if png is not None:
+        from align.io import write_bytes
+
+        write_bytes(plot, png)
+
+
+def plan(
+    rate: opt.Quantity("--rate", "angular_rate", "Table rate, e.g. '100 deg/s'.", "RATE"),
+    accuracy: opt.Quantity("--accuracy", "angle", Accuracy + ".", "ANGLE"),
+    noise_ratio: NoiseRatio = 10.0,
+    arw: Annotated[str | None, typer.Option("--arw", metavar="ARW", help=(
+        "Angle random walk, e.g. '0.3 deg/sqrt(h)'."))] = None,
+    bias_instability: Annotated[str | None, typer.Option("--bias-instability", metavar="RATE", help=(
+        "Bias instability, e.g. '6 deg/h' (with --arw)."))] = None,
+    rate_random_walk: Annotated[str | None, typer.Option("--rate-random-walk", metavar="RRW", help=(
+        "Rate random walk, e.g. '3 deg/h/sqrt(h)' (with --arw)."))] = None,
+    imu: Annotated[str | None, typer.Option("--imu", metavar="PART", help=(
+        "A datasheet preset (see 'budget'), e.g. ADIS16485."))] = None,
+    allan_json: opt.OptInput("--allan", "A result of 'imu-align allan --json'.", "ALLAN.json") = None,
+    turn_angle: opt.Quantity("--turn-angle", "angle", "Turn of the angle method.", "ANGLE") = "360 deg",
+    settle: opt.Quantity("--settle", "time", "Settling time added to each step.", "TIME") = "2 s",
+    steps: Annotated[int, typer.Option("--steps", min=1, help="Table steps (6: +/- about three axes).")] = 6,
+    json_out: opt.JsonOut = None,
+) -> None:
+    """Averaging time per table step for an alignment goal (Example 3), and the whole plan."""
+    from align.errors import InputError
+
+    if sum(x is not None for x in (arw, imu, allan_json)) != 1:
+        raise InputError("give exactly one noise source: {arw} X [{bias_instability} Y], {imu} PART or {allan_json} "
+                         "RESULT.json", "plan")
+    if arw is None and (bias_instability or rate_random_walk):
+        raise InputError("goes with {arw}", "{bias_instability}" if bias_instability else "{rate_random_walk}")
+    if rate <= 0 or accuracy <= 0 or noise_ratio <= 0:
+        raise InputError("rate, accuracy and noise ratio must be positive", "{rate}")
+    check_outputs([allan_json], json_out=json_out)
+    from align.noise import AllanJob, make_plan, plan_from_allan, preset_model
+    from align.parts import get_part
+    from align.present.text import plan_summary
+    from align.results import load_result
+
+    common = dict(turn_angle=turn_angle, steps=steps, settle=settle)
+    if allan_json is not None:
+        job = load_result(allan_json, expect=(AllanJob,))
+        result = plan_from_allan(job, rate, accuracy, noise_ratio, where=str(allan_json), **common)
+    else:
+        label, curve = _model_curve(arw, bias_instability, rate_random_walk) if arw is not None else preset_model(get_part(imu, "{imu}"))
+        result = make_plan(rate, accuracy, noise_ratio, label, sigma=curve, **common)
+    typer.echo(plan_summary(result))
+    if json_out is not None:
+        save_json(json_out, result)
+
+
+def _model_curve(arw: str, bias_instability: str | None, rate_random_walk: str | None):
+    """(label, noise model) from the datasheet figures given on the command line."""
+    from align.noise import model_curve
+    from align.units import parse_quantity as q
+
+    n = q(arw, "angle_random_walk", "{arw}")
+    b = q(bias_instability, "angular_rate", "{bias_instability}") if bias_instability else 0.0
+    k = q(rate_random_walk, "rate_random_walk", "{rate_random_walk}") if rate_random_walk else 0.0
+    label = (f"model: ARW {arw}" + (f", bias instability {bias_instability}" if b else "")
+             + (f", RRW {rate_random_walk}" if k else ""))
+    return label, model_curve(n, b, k)
+
+
+COMMANDS = {"allan": allan, "plan": plan}
