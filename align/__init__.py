@@ -30,5 +30,5 @@ a new file format in ``io``, a new sensor in ``calibration``, a new command in `
 with its logic in the library.
 """
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 CONVENTION = "g = M w + b; w = A (g - b); A = M^-1; rows of M are gyros"

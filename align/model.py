@@ -16,6 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+
 from align.errors import HandednessError
 from align.values import Value, frozen_array
 
@@ -79,12 +80,12 @@ def rotation_vector(r: np.ndarray) -> np.ndarray:
         w = 0.5 * np.sqrt(1.0 + tr)
         v = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]]) / (4.0 * w)
     else:
-        i, j, l = k, (k + 1) % 3, (k + 2) % 3
+        i, j, n = k, (k + 1) % 3, (k + 2) % 3
         v = np.empty(3)
         v[i] = 0.5 * np.sqrt(1.0 + 2.0 * r[i, i] - tr)
-        w = (r[l, j] - r[j, l]) / (4.0 * v[i])
+        w = (r[n, j] - r[j, n]) / (4.0 * v[i])
         v[j] = (r[j, i] + r[i, j]) / (4.0 * v[i])
-        v[l] = (r[l, i] + r[i, l]) / (4.0 * v[i])
+        v[n] = (r[n, i] + r[i, n]) / (4.0 * v[i])
     if w < 0:
         w, v = -w, -v
     norm = np.linalg.norm(v)
@@ -167,7 +168,7 @@ class SensorModel(Value):
         object.__setattr__(self, "bias", frozen_array(self.bias, (3,)))
 
     @classmethod
-    def identity(cls) -> "SensorModel":
+    def identity(cls) -> SensorModel:
         return cls(np.eye(3))
 
     @classmethod
@@ -177,7 +178,7 @@ class SensorModel(Value):
         scale=(1.0, 1.0, 1.0),
         delta=(0.0, 0.0, 0.0),
         bias=(0.0, 0.0, 0.0),
-    ) -> "SensorModel":
+    ) -> SensorModel:
         """Build ``M = diag(scale) N R^T``.
 
         Parameters
@@ -197,7 +198,7 @@ class SensorModel(Value):
         return cls(m, bias)
 
     @classmethod
-    def from_angles(cls, psi, phi, bias=(0.0, 0.0, 0.0)) -> "SensorModel":
+    def from_angles(cls, psi, phi, bias=(0.0, 0.0, 0.0)) -> SensorModel:
         """Eq 5-10: ``M_ii = cos(psi_i)``, ``M_ij = sin(phi_ij)``.
 
         Parameters
@@ -212,7 +213,7 @@ class SensorModel(Value):
         return cls(m, bias)
 
     @classmethod
-    def from_small_angles(cls, alpha: float, beta: float, gamma: float, bias=(0.0, 0.0, 0.0)) -> "SensorModel":
+    def from_small_angles(cls, alpha: float, beta: float, gamma: float, bias=(0.0, 0.0, 0.0)) -> SensorModel:
         """First-order model of a package rotated by ``alpha, beta, gamma`` (rad)."""
         return cls(small_rotation_matrix(alpha, beta, gamma), bias)
 

@@ -46,13 +46,13 @@ class Unit:
     factor: float
     dim: tuple[Fraction, ...]
 
-    def __mul__(self, other: "Unit") -> "Unit":
+    def __mul__(self, other: Unit) -> Unit:
         return Unit(self.factor * other.factor, tuple(a + b for a, b in zip(self.dim, other.dim)))
 
-    def __truediv__(self, other: "Unit") -> "Unit":
+    def __truediv__(self, other: Unit) -> Unit:
         return Unit(self.factor / other.factor, tuple(a - b for a, b in zip(self.dim, other.dim)))
 
-    def __pow__(self, p: Fraction) -> "Unit":
+    def __pow__(self, p: Fraction) -> Unit:
         return Unit(self.factor ** float(p), tuple(a * p for a in self.dim))
 
 

@@ -63,7 +63,8 @@ def main() -> None:
     ours = json.loads(ours_json.read_text())
     theirs = json.loads(theirs_json.read_text())
     worst = max(np.max(np.abs(np.array(theirs[str(j)]) / np.array(ours["adev"][f"c{j}"]) - 1)) for j in range(args.channels))
-    print(f"input: {args.samples:,} x {args.channels} float64 = {size_mb:.0f} MB .npy at 2 kHz; {len(ours['tau'])} taus (dense grid)")
+    print(f"input: {args.samples:,} x {args.channels} float64 = {size_mb:.0f} MB .npy at 2 kHz; "
+          f"{len(ours['tau'])} taus (dense grid)")
     print(f"allantools oadev script (whole process): {t_at:7.2f} s   peak RSS {m_at:7.0f} MB")
     print(f"imu-align allan         (whole process): {t_ours:7.2f} s   peak RSS {m_ours:7.0f} MB  "
           f"({m_ours / size_mb:.2f}x the input array)")

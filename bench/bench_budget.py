@@ -58,9 +58,11 @@ def main() -> None:
     t_naive = naive_2d(args.draws, 1)
     wall, rss = measure([sys.executable, "-m", "align.cli", "budget", str(MOUNT), "--monte-carlo", str(args.draws)])
     print(f"Monte Carlo, {args.draws:,} draws of the 3-D model: {t_mc:.3f} s in-process, "
-          f"peak RSS {peak:.0f} MB (before: {before / 1024:.0f} MB); p99.73 any axis {np.degrees(mc.percentiles['99.73'][3]):.4f} deg")
+          f"peak RSS {peak:.0f} MB (before: {before / 1024:.0f} MB); "
+          f"p99.73 any axis {np.degrees(mc.percentiles['99.73'][3]):.4f} deg")
     print(f"whole `imu-align budget --monte-carlo {args.draws}` process: {wall:.3f} s, peak RSS {rss:.0f} MB")
-    print(f"naive 2-D RSS draw of the source terms (reference for scale): {t_naive:.3f} s; ratio 3-D / naive {t_mc / t_naive:.1f}")
+    print(f"naive 2-D RSS draw of the source terms (reference for scale): {t_naive:.3f} s; "
+          f"ratio 3-D / naive {t_mc / t_naive:.1f}")
     print("target: under 1 s and under 500 MB")
 
 

@@ -21,10 +21,10 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from align.io import write_csv, write_text  # noqa: E402
-from align.model import SensorModel  # noqa: E402
 from align.alignment.plan import Plan, Step  # noqa: E402
 from align.alignment.simulate import SessionSpec, simulate_session  # noqa: E402
+from align.io import write_csv, write_text  # noqa: E402
+from align.model import SensorModel  # noqa: E402
 from align.units import DEG, to_unit  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))

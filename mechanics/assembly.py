@@ -17,7 +17,6 @@ from itertools import product
 import numpy as np
 
 from align.errors import InputError
-
 from mechanics.formulas import screw_radius
 from mechanics.mount import Mount
 from mechanics.rest import corner_geometry, rest_plane_hull, rest_planes

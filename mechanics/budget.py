@@ -30,7 +30,6 @@ from align import CONVENTION
 from align.errors import InputError
 from align.results import Result, register
 from align.units import DEG
-
 from mechanics.assembly import skew_limit, worst_case_per_axis
 from mechanics.formulas import rss, screw_radius, skew_from_screws, tilt_from_ledges
 from mechanics.montecarlo import MonteCarlo
@@ -135,9 +134,12 @@ class Budget(Result):
             "worst_case_per_axis_deg": _xyz_deg(self.worst_case_per_axis),
             "skew_worst_deg": self.skew_worst / DEG,
             "method": {
-                "source": "Eq 2-3 tilts from the full height band, Eq 4 skew, mounting = max, total = RSS with axis-to-package (Eq 1)",
-                "per_axis": "RSS of the terms that move each gyro axis (x: tilt_y, skew, imu_x, extras; y: tilt_x, skew, imu_y, extras; z: tilt_x, tilt_y, imu_z, extras)",
-                "worst_case": "corners of the ledge-height box through the rest model and the skew limit (with screw position tolerance), composed in 3-D, plus datasheet and extra terms",
+                "source": ("Eq 2-3 tilts from the full height band, Eq 4 skew, mounting = max, "
+                           "total = RSS with axis-to-package (Eq 1)"),
+                "per_axis": ("RSS of the terms that move each gyro axis (x: tilt_y, skew, imu_x, extras; "
+                             "y: tilt_x, skew, imu_y, extras; z: tilt_x, tilt_y, imu_z, extras)"),
+                "worst_case": ("corners of the ledge-height box through the rest model and the skew limit "
+                               "(with screw position tolerance), composed in 3-D, plus datasheet and extra terms"),
             },
             "mount": self.mount.to_dict(),
         }

@@ -20,7 +20,6 @@ import numpy as np
 
 from align.units import DEG
 from align.values import Value, frozen_array
-
 from mechanics.assembly import rotate_axes, skew_limit, worst_case_per_axis
 from mechanics.mount import Mount
 from mechanics.rest import corner_geometry, plane_tilt, rest_planes
@@ -155,9 +154,9 @@ def _draw(m: Mount, geo, k: int, rng: np.random.Generator, include) -> tuple[np.
     if "imu" in include:
         for i in range(3):
             d2 = _disc(rng, k, m.axis_to_package[i], m.distributions["imu"])
-            j, l = (i + 1) % 3, (i + 2) % 3
+            j, n = (i + 1) % 3, (i + 2) % 3
             axes[:, i, j] += d2[:, 0]
-            axes[:, i, l] += d2[:, 1]
+            axes[:, i, n] += d2[:, 1]
     if "extras" in include:
         for bound in m.extras.values():
             axes += np.cross(_ball(rng, k, bound, m.distributions["extras"])[:, None, :], np.eye(3)[None])  # w x e_i

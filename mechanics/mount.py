@@ -20,7 +20,6 @@ from align.errors import InputError
 from align.parts import get_part
 from align.units import DEG, parse_quantity
 from align.values import Value
-
 from mechanics.formulas import screw_radius
 
 #: how a tolerance is drawn in the Monte Carlo (normal: the band or bound is +/- 3 sigma)

@@ -15,7 +15,6 @@ import io
 import numpy as np
 
 from align.units import DEG
-
 from mechanics.budget import Budget
 from mechanics.mount import Mount
 from mechanics.rest import rest_plane_hull

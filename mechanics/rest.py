@@ -176,7 +176,8 @@ def ledges_from_stl(path, band: float, where: str) -> tuple[np.ndarray, np.ndarr
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise InputError("no triangles in the STL", where)
     scale = 1e-3 if np.max(mesh.extents) > 1.0 else 1.0
-    groups = [list(f) for f in mesh.facets] + [[i] for i in set(range(len(mesh.faces))) - set(np.concatenate(mesh.facets) if len(mesh.facets) else [])]
+    in_facets = set(np.concatenate(mesh.facets)) if len(mesh.facets) else set()
+    groups = [list(f) for f in mesh.facets] + [[i] for i in set(range(len(mesh.faces))) - in_facets]
     tops = []
     for faces in groups:
         normal = mesh.face_normals[faces[0]]

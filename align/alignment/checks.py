@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from align.errors import HandednessError, InputError, TestError
 from align.alignment.plan import Plan, axis_name
 from align.alignment.segment import Segment
+from align.errors import HandednessError, TestError
 from align.units import format_quantity, unit_mixup_hint
 from align.values import Value
 
@@ -51,7 +51,8 @@ def check_span(plan: Plan, allow_two_axis: bool = False) -> int | None:
     names = ", ".join(axis_name(a)[1] for a in sorted(turned))
     if allow_two_axis and len(missing) == 1:
         return missing[0]
-    hint = "add steps about it or set {method=two-axis} (assumes orthogonal gyros)" if len(missing) == 1 else "add steps about them"
+    hint = ("add steps about it or set {method=two-axis} (assumes orthogonal gyros)" if len(missing) == 1
+            else "add steps about them")
     raise TestError(
         f"the rotations do not span 3-D: the plan turns about {names} only, never about "
         f"{', '.join(axis_name(a)[1] for a in missing)}; {hint}",
@@ -121,7 +122,8 @@ def check_directions(measured: list[tuple[Segment, float, float]], plan: Plan, t
             )
     for (seg, along, across), ratio, step, value in zip(measured, ratios, steps, planned):
         unit = units if step.rate is not None else "deg"
-        said = f"planned {format_quantity(value, unit, 5)} about {axis_name(step.axis, step.sign)}, measured {format_quantity(along, unit, 5)}"
+        said = (f"planned {format_quantity(value, unit, 5)} about {axis_name(step.axis, step.sign)}, "
+                f"measured {format_quantity(along, unit, 5)}")
         if ratio < 0:
             raise TestError(f"{said}: the table turned the wrong way; re-run the step or correct its sign in the plan", seg.name)
         if abs(across) > 0.5 * abs(along):
@@ -133,7 +135,8 @@ def check_directions(measured: list[tuple[Segment, float, float]], plan: Plan, t
         if abs(ratio - 1) > tolerance:
             what = "rate" if step.rate is not None else "angle"
             raise TestError(
-                f"{said}: off by {100 * (ratio - 1):+.1f} % (tolerance {100 * tolerance:g} %); wrong table {what} or wrong plan step",
+                f"{said}: off by {100 * (ratio - 1):+.1f} % (tolerance {100 * tolerance:g} %); "
+                f"wrong table {what} or wrong plan step",
                 seg.name,
             )
     return Check("directions", "pass", f"every step within {100 * tolerance:g} % of the plan, in the planned direction")

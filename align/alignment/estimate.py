@@ -27,12 +27,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from align.alignment.plan import Plan, axis_name
+from align.alignment.segment import Segment, integrate
 from align.earth import vertical_rate
 from align.errors import TestError
 from align.model import nearest_rotation
 from align.values import Value
-from align.alignment.plan import Plan, axis_name
-from align.alignment.segment import Segment, integrate
 
 
 @dataclass(frozen=True, eq=False)
@@ -98,7 +98,8 @@ def _batch_mean_var(x: np.ndarray, batches: int = 10) -> np.ndarray:
     return np.var(means, axis=0, ddof=1) / batches
 
 
-def observe(t: np.ndarray, g: np.ndarray, segments: list[Segment], plan: Plan, sigma: np.ndarray, earth: bool = False) -> list[Observation]:
+def observe(t: np.ndarray, g: np.ndarray, segments: list[Segment], plan: Plan, sigma: np.ndarray,
+            earth: bool = False) -> list[Observation]:
     """Turn segments into linear observations (see module docstring).
 
     Parameters
@@ -219,7 +220,8 @@ def _pairs(obs: list[Observation], plan: Plan, kind: str) -> dict[int, tuple[Obs
     pairs = {a: (d[1], d[-1]) for a, d in found.items() if 1 in d and -1 in d}
     missing = [axis_name(a) for a in range(3) if a not in pairs]
     if missing:
-        raise TestError(f"the {kind} method needs one +{kind} and one -{kind} step about each axis; none complete about {', '.join(missing)} (set {{method=lsq}})")
+        raise TestError(f"the {kind} method needs one +{kind} and one -{kind} step about each axis; "
+                        f"none complete about {', '.join(missing)} (set {{method=lsq}})")
     return pairs
 
 

@@ -17,16 +17,30 @@ from typing import ClassVar
 import numpy as np
 
 from align import CONVENTION
-from align.alignment.checks import (Check, check_directions, check_durations, check_residuals,
-                     check_saturation, check_scale, check_span)
+from align.alignment.checks import (
+    Check,
+    check_directions,
+    check_durations,
+    check_residuals,
+    check_saturation,
+    check_scale,
+    check_span,
+)
+from align.alignment.estimate import (
+    alignment_sigma,
+    fit_angle_pairs,
+    fit_lsq,
+    fit_rate_pairs,
+    observe,
+    two_axis,
+    two_axis_error_bound,
+)
+from align.alignment.plan import Plan
+from align.alignment.segment import Segment, SegmentOptions, noise_sigma, segment_log
 from align.earth import EARTH_RATE, vertical_rate
 from align.errors import InputError
-from align.alignment.estimate import (alignment_sigma, fit_angle_pairs, fit_lsq, fit_rate_pairs, observe,
-                       two_axis, two_axis_error_bound)
-from align.model import Angles, SensorModel, angles, check_handedness
-from align.alignment.plan import Plan
 from align.io import c_header, check_log
-from align.alignment.segment import Segment, SegmentOptions, noise_sigma, segment_log
+from align.model import Angles, SensorModel, angles, check_handedness
 from align.results import Result, register
 from align.units import DEG, DEG_H, parse_unit, to_unit
 from align.values import Value
@@ -186,7 +200,7 @@ class AlignmentResult(Result):
         }
 
     @classmethod
-    def from_dict(cls, d: dict, where: str = "result") -> "AlignmentResult":
+    def from_dict(cls, d: dict, where: str = "result") -> AlignmentResult:
         """Read the form written by :meth:`to_dict` (any version up to the current one)."""
         cls.check_envelope(d, where)
         try:

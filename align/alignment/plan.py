@@ -104,7 +104,7 @@ class Plan:
         return {s.axis for s in self.steps}
 
     @classmethod
-    def from_dict(cls, data: dict, where: str = "plan") -> "Plan":
+    def from_dict(cls, data: dict, where: str = "plan") -> Plan:
         """Build a plan from the parsed TOML (see module docstring)."""
         raw = data.get("step")
         if not isinstance(raw, list) or not raw:
@@ -160,13 +160,13 @@ class Plan:
         return "\n".join(lines)
 
     @classmethod
-    def standard_rate(cls, rate: float, latitude: float | None = None) -> "Plan":
+    def standard_rate(cls, rate: float, latitude: float | None = None) -> Plan:
         """The six-dwell +/- rate plan about x, y, z (Eq 28-30); ``rate`` in rad/s."""
         steps = tuple(Step(a, 1, rate=r) for a in range(3) for r in (rate, -rate))
         return cls(steps, latitude)
 
     @classmethod
-    def standard_angle(cls, angle: float) -> "Plan":
+    def standard_angle(cls, angle: float) -> Plan:
         """Six turns, +/- ``angle`` (rad) about x, y, z (Eq 31)."""
         steps = tuple(Step(a, 1, angle=t) for a in range(3) for t in (angle, -angle))
         return cls(steps)

@@ -19,8 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from align.errors import InputError, TestError
 from align.alignment.plan import Plan
+from align.errors import InputError, TestError
 from align.units import DEG_S, unit_mixup_hint
 
 
@@ -210,7 +210,8 @@ def segment_log(
                 raise TestError(hint, where)
             raise TestError(
                 f"found {len(moving)} constant-rate dwells but the plan has {len(plan.steps)} steps; "
-                f"dwells found: {_describe(g, t, moving) or 'none'}; check the plan, {{window}}/{{min_dwell}}, or give {{segments}}",
+                f"dwells found: {_describe(g, t, moving) or 'none'}; "
+                "check the plan, {window}/{min_dwell}, or give {segments}",
                 where,
             )
         segs = [Segment(f"step {k + 1} ({s.label})", "rate", a, b, k) for k, (s, (a, b)) in enumerate(zip(plan.steps, moving))]

@@ -20,8 +20,16 @@ calibrate_accel_free, ferraris, sections_from_dict, SECTIONS, MagCalibration, ca
 alignment_to_gravity, misalignment_from_axes_down, MODELS
 """
 
-from align.calibration.accel import (FACES, StaticDetector, accel_session, calibrate_accel, calibrate_accel_free,
-                                     calibrate_accel_log, face_ups, static_means)
+from align.calibration.accel import (
+                                     FACES,
+                                     StaticDetector,
+                                     accel_session,
+                                     calibrate_accel,
+                                     calibrate_accel_free,
+                                     calibrate_accel_log,
+                                     face_ups,
+                                     static_means,
+)
 from align.calibration.ellipsoid import MODELS
 from align.calibration.ferraris import SECTIONS, ferraris, sections_from_dict
 from align.calibration.magnetometer import (
@@ -33,7 +41,8 @@ from align.calibration.magnetometer import (
 )
 from align.calibration.results import SENSORS, Calibration, CalibrationSet
 
-__all__ = ["Calibration", "CalibrationSet", "SENSORS", "FACES", "face_ups", "static_means", "accel_session", "calibrate_accel_log", "StaticDetector",
+__all__ = ["Calibration", "CalibrationSet", "SENSORS", "FACES", "face_ups", "static_means", "accel_session",
+           "calibrate_accel_log", "StaticDetector",
            "calibrate_accel", "calibrate_accel_free", "ferraris", "sections_from_dict", "SECTIONS", "MagCalibration",
            "calibrate_magnetometer", "with_gravity_alignment", "alignment_to_gravity",
            "misalignment_from_axes_down", "MODELS"]

@@ -5,7 +5,6 @@ Public names
 matrix, apply, simulate, COMMANDS
 """
 
-from pathlib import Path
 
 import typer
 

@@ -5,7 +5,6 @@ Public names
 app, ferraris, accel, mag, COMMANDS
 """
 
-from pathlib import Path
 from typing import Annotated
 
 import typer
@@ -43,7 +42,8 @@ def ferraris(
 
     _, acc = fileio.read_log(log, names(accel_columns), accel_units, None, rate_hz, expect="acceleration")
     _, gyr = fileio.read_log(log, names(gyro_columns), gyro_units, None, rate_hz)
-    acc_cal, gyr_cal = compute(acc, gyr, rate_hz, sections_from_dict(fileio.read_json(sections), str(sections)), turn_angle, gravity, accel_units, gyro_units,
+    ranges = sections_from_dict(fileio.read_json(sections), str(sections))
+    acc_cal, gyr_cal = compute(acc, gyr, rate_hz, ranges, turn_angle, gravity, accel_units, gyro_units,
                                pairwise_bias=value(bias) == "pairwise", g_sensitivity=g_sensitivity)
     result = CalibrationSet({"accelerometer": acc_cal, "gyroscope": gyr_cal},
                             {"log": str(log), "sections": str(sections)})

@@ -132,7 +132,10 @@ def plan(
         job = load_result(allan_json, expect=(AllanJob,))
         result = plan_from_allan(job, rate, accuracy, noise_ratio, where=str(allan_json), **common)
     else:
-        label, curve = _model_curve(arw, bias_instability, rate_random_walk) if arw is not None else preset_model(get_part(imu, "{imu}"))
+        if arw is not None:
+            label, curve = _model_curve(arw, bias_instability, rate_random_walk)
+        else:
+            label, curve = preset_model(get_part(imu, "{imu}"))
         result = make_plan(rate, accuracy, noise_ratio, label, sigma=curve, **common)
     typer.echo(plan_summary(result))
     if json_out is not None:

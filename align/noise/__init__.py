@@ -24,15 +24,21 @@ PlanResult, Averaging, noise_target, model_curve, averaging_time, longest_turn, 
 AllanJob, run_allan, read_runs, plan_from_allan, term_units (job)
 """
 
-from align.noise.model import FLICKER_FACTOR, NOISE_ALPHA, TERMS, NoiseModel, avar_design, model_adev, model_avar
-from align.noise.allan import (AllanResult, ArrayChunks, allan, confidence_interval, edf_overlapping, tau_grid,
-                               window_stability)
+from align.noise.allan import AllanResult, ArrayChunks, allan, confidence_interval, edf_overlapping, tau_grid, window_stability
 from align.noise.fit import NoiseFit, fit_noise, nnls_small, noise_figures, point_readouts
-from align.noise.sim import (FLICKER_MODELS, NoiseSpec, seed_method_a, seed_method_b, seed_restoring, simulate_imu,
-                             simulate_noise)
-from align.noise.planner import (Averaging, PlanResult, averaging_time, longest_turn, make_plan, model_curve,
-                                 noise_target, preset_model)
 from align.noise.job import AllanJob, plan_from_allan, read_runs, run_allan, term_units
+from align.noise.model import FLICKER_FACTOR, NOISE_ALPHA, TERMS, NoiseModel, avar_design, model_adev, model_avar
+from align.noise.planner import (
+                               Averaging,
+                               PlanResult,
+                               averaging_time,
+                               longest_turn,
+                               make_plan,
+                               model_curve,
+                               noise_target,
+                               preset_model,
+)
+from align.noise.sim import FLICKER_MODELS, NoiseSpec, seed_method_a, seed_method_b, seed_restoring, simulate_imu, simulate_noise
 
 __all__ = [
     "FLICKER_FACTOR", "NOISE_ALPHA", "TERMS", "NoiseModel", "avar_design", "model_adev", "model_avar",

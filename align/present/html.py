@@ -112,7 +112,8 @@ def budget_section(b, histogram_png: bytes | None, assembly_png: bytes | None) -
             + "<p>Misalignment of each gyro axis from its system axis (a tilt about x moves the y and z gyros):</p>"
             + table(["deg", "x gyro", "y gyro", "z gyro"], axis_rows))
     if mc:
-        body += f'<p class="note">Monte Carlo: {mc["draws"]:,} assemblies, seed {mc["seed"]}; rest model on the ledges, screws uniform over the poses that fit.</p>'
+        body += (f'<p class="note">Monte Carlo: {mc["draws"]:,} assemblies, seed {mc["seed"]}; rest model on the ledges, '
+                 "screws uniform over the poses that fit.</p>")
     if histogram_png:
         body += image(histogram_png, "Monte Carlo histogram of the per-axis misalignment")
     if assembly_png:
@@ -173,7 +174,8 @@ def allan_section(job: AllanJob | None, plot_png: bytes | None, plan: PlanResult
             ["table rate", f"{p['rate_deg_s']:g} deg/s"], ["alignment goal", f"{p['accuracy_deg']:g} deg"],
             ["noise ratio", f"{p['noise_ratio']:g}"], ["noise target", f"{p['noise_target_deg_h']:.4f} deg/h"],
             ["averaging time per step", avg], ["reason", p["reason"]],
-            ["total table time", "-" if p["test_plan"]["total_table_time_s"] is None else f"{p['test_plan']['total_table_time_s']:.4g} s"],
+            ["total table time", "-" if p["test_plan"]["total_table_time_s"] is None
+             else f"{p['test_plan']['total_table_time_s']:.4g} s"],
             ["noise source", p["noise_source"]]])
     return Section("Noise and test planning", body)
 
@@ -193,7 +195,8 @@ def alignment_section(r) -> Section:
         seg_rows.append([s.name, s.kind, f"{s.t_start:.2f}-{s.t_end:.2f}"] + [f"{v:+.2e}" for v in res]
                         + ["deg" if scale else u])
     check_rows = [[c.name, (c.status, "pass" if c.status == "pass" else "warn"), c.detail] for c in r.checks]
-    body = (f"<p>Method <b>{esc(r.method)}</b>; condition number {r.condition_number:.3g}; {r.dof} degrees of freedom per gyro.</p>"
+    body = (f"<p>Method <b>{esc(r.method)}</b>; condition number {r.condition_number:.3g}; "
+            f"{r.dof} degrees of freedom per gyro.</p>"
             "<p>M (1-sigma):</p>" + mat(r.M, r.sigma_M)
             + "<p>A = M<sup>-1</sup>, to load into firmware (1-sigma):</p>" + mat(r.A, r.sigma_A)
             + f"<p>bias [{esc(u)}]: {esc(bias)}</p>"

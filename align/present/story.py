@@ -18,7 +18,8 @@ from pathlib import Path
 import numpy as np
 
 from align.io import read_log, read_static, read_toml, write_bytes, write_csv, write_text
-from align.units import DEG, DEG_H, parse_quantity as q
+from align.units import DEG, DEG_H
+from align.units import parse_quantity as q
 
 DEMO = Path(__file__).with_name("demo")
 DEMO_TITLE = "imu-align demo: ADIS16485 on a vehicle antenna platform"
@@ -26,10 +27,10 @@ DEMO_TITLE = "imu-align demo: ADIS16485 on a vehicle antenna platform"
 
 def demo_inputs(out: Path, seed: int = 0) -> dict:
     """Write the demo's inputs into ``out`` and return their paths and reading options."""
-    from align.model import SensorModel
-    from align.noise.sim import NoiseSpec, simulate_noise
     from align.alignment.plan import Plan
     from align.alignment.simulate import SessionSpec, SimulationTruth, simulate_session
+    from align.model import SensorModel
+    from align.noise.sim import NoiseSpec, simulate_noise
     from align.units import to_unit
 
     mount, manoeuvre = out / "mount.toml", out / "manoeuvre.toml"
@@ -72,13 +73,12 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
                  accuracy: str = "0.1 deg", noise_ratio: float = 10.0, monte_carlo: int = 100_000, seed: int = 0,
                  basis: str = "rss", progress=None, title: str = "IMU alignment report") -> tuple[str, str, dict]:
     """Run every job whose inputs are given; return (HTML, summary text, results)."""
+    import align.present.html as report
+    from align.sensitivity import allowable, check_margins, manoeuvre_from_dict
     from mechanics.budget import budget
     from mechanics.montecarlo import monte_carlo as run_mc
     from mechanics.mount import mount_from_dict
     from mechanics.render import assembly_png, histogram_png
-
-    import align.present.html as report
-    from align.sensitivity import allowable, check_margins, manoeuvre_from_dict
 
     inputs = {"mount": (str(mount), Path(mount).read_text()), "manoeuvre": (str(manoeuvre), Path(manoeuvre).read_text())}
     m = mount_from_dict(read_toml(mount), str(mount), Path(mount).parent)
@@ -126,7 +126,8 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
         results["alignment"] = r
         ang = r.angles
         lines.append(f"alignment: psi = {', '.join(f'{v / DEG:.3f}' for v in ang.psi)} deg, "
-                     f"sigma(M) <= {np.nanmax(r.sigma_M):.1e}, checks {'all pass' if all(c.status == 'pass' for c in r.checks) else 'with warnings'}")
+                     f"sigma(M) <= {np.nanmax(r.sigma_M):.1e}, "
+                     f"checks {'all pass' if all(c.status == 'pass' for c in r.checks) else 'with warnings'}")
     sections.insert(0, report.inputs_section(inputs))
     return report.html_report(title, sections), "\n".join(lines), results
 

@@ -11,9 +11,9 @@ allan_summary, plan_summary, calibration_summary, magnetometer_summary
 
 from __future__ import annotations
 
-import numpy as np
-
 from typing import TYPE_CHECKING
+
+import numpy as np
 
 from align.alignment.job import AlignmentResult
 from align.units import DEG, to_unit
@@ -76,7 +76,8 @@ def budget_summary(b) -> str:
         "",
         f"  part {m['part'] or '-'}, axis-to-package {', '.join(f'{v:.3g}' for v in m['axis_to_package_deg'])} deg, "
         f"package {m['package_mm'][0]:g} x {m['package_mm'][1]:g} mm, ledges {m['ledge_size_mm']:g} mm, "
-        f"height band {m['height_tolerance_mm']:g} mm, screws {m['screw_diameter_mm']:g} mm in {m['hole_diameter_mm']:g} mm holes, "
+        f"height band {m['height_tolerance_mm']:g} mm, "
+        f"screws {m['screw_diameter_mm']:g} mm in {m['hole_diameter_mm']:g} mm holes, "
         f"R_S {m['screw_radius_mm']:.4f} mm",
         "",
         "  source (Eq 1-4)                        deg",
@@ -94,7 +95,8 @@ def budget_summary(b) -> str:
     mc = d.get("monte_carlo")
     if mc:
         for p, vals in mc["percentiles_deg"].items():
-            lines.append(f"    Monte Carlo p{p:<6}  " + "".join(f"{vals[a]:11.5f}" for a in "xyz") + f"   any axis {vals['any']:.5f}")
+            lines.append(f"    Monte Carlo p{p:<6}  " + "".join(f"{vals[a]:11.5f}" for a in "xyz")
+                         + f"   any axis {vals['any']:.5f}")
         lines.append("    Monte Carlo max      " + "".join(f"{mc['max_deg'][a]:11.5f}" for a in "xyz")
                      + f"   ({mc['draws']:,} draws, seed {mc['seed']})")
     lines += ["", f"  worst case over all axes {d['worst_case_deg']:.5f} deg; source total {d['total_deg']:.5f} deg"]
@@ -115,7 +117,8 @@ def allowable_summary(a) -> str:
     ag = a.agreement
     lines += ["", f"  binding element: {a.binding} = {_deg(a.binding_value)} deg",
               f"  largest rigid misalignment cone (any direction): {a.cone / DEG:.4f} deg",
-              "", f"  check at {ag['element']} = {ag['element_deg'] if ag['element_deg'] is None else round(ag['element_deg'], 6)} deg"
+              "", f"  check at {ag['element']} = "
+              f"{ag['element_deg'] if ag['element_deg'] is None else round(ag['element_deg'], 6)} deg"
               " (per-gyro integrated-angle error, deg):",
               "    closed form (Eq 11-13)  " + "  ".join(f"{k}={v:+.6f}" for k, v in ag["closed_form_deg"].items()),
               "    attitude propagation    " + "  ".join(f"{k}={v:+.6f}" for k, v in ag["propagated_deg"].items()),
@@ -129,7 +132,8 @@ def margin_summary(rows, basis: str) -> str:
              "  element     predicted      allowed       margin   result"]
     for r in rows:
         margin = "-" if not np.isfinite(r.allowed) else f"{r.margin / DEG:+.4f}"
-        lines.append(f"  {r.element:<10} {r.predicted / DEG:10.4f} {_deg(r.allowed):>13} {margin:>12}   {'pass' if r.ok else 'FAIL'}")
+        verdict = "pass" if r.ok else "FAIL"
+        lines.append(f"  {r.element:<10} {r.predicted / DEG:10.4f} {_deg(r.allowed):>13} {margin:>12}   {verdict}")
     failed = [r.element for r in rows if not r.ok]
     lines += ["", "  result: " + ("PASS" if not failed else f"FAIL ({', '.join(failed)})")]
     return "\n".join(lines)
@@ -151,7 +155,8 @@ def allan_summary(job: AllanJob) -> str:
         r = fit["ieee_point_readouts"]
         fmt = lambda v: "-" if v is None else f"{v:.4g}"  # noqa: E731
         lines.append(f"    IEEE point readouts: N(tau=1 s) {fmt(r['N_at_tau_1s'])} {r['N_unit']}, "
-                     f"floor/0.664 {fmt(r['B_floor_over_0.664'])} {r['B_unit']}, K(tau=3 s) {fmt(r['K_at_tau_3s'])} {r['K_unit']}")
+                     f"floor/0.664 {fmt(r['B_floor_over_0.664'])} {r['B_unit']}, "
+                     f"K(tau=3 s) {fmt(r['K_at_tau_3s'])} {r['K_unit']}")
         fig = d["figures"][name]
         stab = ", ".join(f"{p}: {v:.4g}" for p, v in fig["bias_stability"].items())
         lines.append(f"    bias {fig['bias']:.6g} {u['bias']}; bias stability ({stab}) {u['bias']}")
@@ -173,7 +178,8 @@ def plan_summary(plan: PlanResult) -> str:
              f"  curve floor         {d['floor_deg_h']:.4g} deg/h at tau {d['floor_tau_s']:.3g} s"]
     if d["feasible"]:
         lines.append(f"  averaging time      {d['averaging_time_s']:.4g} s per step  ({d['reason']})")
-        lines.append(f"  whole test          {tp['steps']} steps x ({d['averaging_time_s']:.4g} s + {tp['settle_s']:g} s settling) = "
+        lines.append(f"  whole test          {tp['steps']} steps x "
+                     f"({d['averaging_time_s']:.4g} s + {tp['settle_s']:g} s settling) = "
                      f"{tp['total_table_time_s']:.4g} s of table time")
     else:
         lines.append(f"  averaging time      none: {d['reason']}")
@@ -209,7 +215,8 @@ def magnetometer_summary(c) -> str:
     d = c.to_dict()
     u, q = d["units"]["hard_iron"], d["quality"]
     lines = [f"magnetometer ({d['model']} soft iron), convention {d['convention']}",
-             f"  hard iron [{u}]: " + ", ".join(f"{h:+.5g} ± {s:.2g}" for h, s in zip(d["hard_iron"], d["uncertainty"]["hard_iron"])),
+             f"  hard iron [{u}]: "
+             + ", ".join(f"{h:+.5g} ± {s:.2g}" for h, s in zip(d["hard_iron"], d["uncertainty"]["hard_iron"])),
              "  soft iron:", matrix_text(c.soft_iron, None, 5, "    "),
              f"  field {d['field']:.5g} {u}; field-magnitude spread {100 * q['field_spread_before']:.2f} % before, "
              f"{100 * q['field_spread_after']:.2f} % after; direction coverage {q['coverage']:.3f} (full sphere 0.333)",

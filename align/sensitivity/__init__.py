@@ -20,8 +20,7 @@ Allowable, allowable, Margin, margins, MarginTable, check_margins (from ``allowa
 from align.sensitivity.allowable import Allowable, Margin, MarginTable, allowable, check_margins, margins
 from align.sensitivity.attitude import closed_form_errors, output_errors
 from align.sensitivity.manoeuvre import Manoeuvre, manoeuvre_from_dict
-from align.sensitivity.symbolic import (ELEMENTS, OUTPUTS, matrix_from_angles, response, sensitivity, symbolic,
-                                        symbolic_text)
+from align.sensitivity.symbolic import ELEMENTS, OUTPUTS, matrix_from_angles, response, sensitivity, symbolic, symbolic_text
 
 __all__ = ["ELEMENTS", "OUTPUTS", "symbolic", "symbolic_text", "matrix_from_angles", "response", "sensitivity",
            "Manoeuvre", "manoeuvre_from_dict", "output_errors", "closed_form_errors",

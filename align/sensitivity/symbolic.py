@@ -97,7 +97,8 @@ def symbolic_text(style: str = "pretty") -> str:
     show = (lambda e: sp.latex(e)) if style == "latex" else (lambda e: sp.pretty(e, use_unicode=False))
     return "\n\n".join([
         "Gyro response g = M w (Eq 5-10):", show(sp.Eq(sp.Symbol("g"), s.g, evaluate=False)),
-        "Integrated, fixed-axis rotation theta_G = M theta (Eq 11-13):", show(sp.Eq(sp.Symbol("theta_G"), s.theta_G, evaluate=False)),
+        "Integrated, fixed-axis rotation theta_G = M theta (Eq 11-13):",
+        show(sp.Eq(sp.Symbol("theta_G"), s.theta_G, evaluate=False)),
         f"Sensitivity d g / d ({', '.join(ELEMENTS)}):", show(s.jacobian),
     ])
 

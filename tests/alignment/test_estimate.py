@@ -2,17 +2,17 @@
 
 import numpy as np
 import pytest
+from conftest import truth_model
 from scipy.spatial.transform import Rotation
 
-from align.alignment.job import AlignOptions, align
 from align.alignment.estimate import Observation, fit_rate_pairs, two_axis_error_bound
-from align.model import SensorModel
+from align.alignment.job import AlignOptions, align
 from align.alignment.plan import Plan, Step
 from align.alignment.segment import Segment
 from align.alignment.simulate import SessionSpec, simulate_session
-from align.units import DEG, parse_quantity as q
-
-from conftest import truth_model
+from align.model import SensorModel
+from align.units import DEG
+from align.units import parse_quantity as q
 
 NOISELESS = SessionSpec(noise_density=0.0)
 

@@ -4,10 +4,10 @@ import json
 
 import numpy as np
 import pytest
+from conftest import SHARED
 
 from align.calibration import accel_session, calibrate_accel
 from align.errors import InputError, TestError
-from conftest import SHARED
 
 XSENS = SHARED / "data" / "multiposition" / "xsens_mti_imu_tk"
 

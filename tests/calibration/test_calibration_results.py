@@ -4,6 +4,7 @@ import json
 
 import numpy as np
 import pytest
+from magsim import F, capture, truth
 
 from align.calibration import Calibration, CalibrationSet, MagCalibration, calibrate_magnetometer
 from align.calibration.results import CONVENTION
@@ -11,7 +12,6 @@ from align.errors import InputError
 from align.io.export import imucal_dict
 from align.results import load_result, result_from_dict, save_result
 from align.values import approx_equal
-from magsim import F, capture, truth
 
 
 def _calibration(sensor: str, units: str, seed: int = 0, kga: bool = False) -> Calibration:

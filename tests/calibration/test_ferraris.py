@@ -5,10 +5,10 @@ import json
 import numpy as np
 import pandas as pd
 import pytest
+from conftest import SHARED
 
 from align.calibration import Calibration, ferraris
 from align.units import DEG
-from conftest import SHARED
 
 FERRARIS = SHARED / "data" / "multiposition" / "imucal_ferraris"
 

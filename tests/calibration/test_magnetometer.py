@@ -4,13 +4,13 @@ import json
 
 import numpy as np
 import pytest
+from conftest import SHARED
+from magsim import F, capture, truth
 from scipy.spatial.transform import Rotation
 
 from align.calibration import MagCalibration, calibrate_magnetometer, with_gravity_alignment
 from align.errors import InputError, TestError
 from align.units import DEG
-from conftest import SHARED
-from magsim import F, capture, truth
 
 MAG = SHARED / "data" / "magnetometer"
 

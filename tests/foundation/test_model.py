@@ -3,8 +3,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from align.errors import HandednessError
-from align.model import (SensorModel, angles, check_handedness, nearest_rotation, non_orthogonal_axes,
-                         small_rotation_matrix)
+from align.model import SensorModel, angles, check_handedness, nearest_rotation, non_orthogonal_axes, small_rotation_matrix
 from align.units import DEG
 
 

@@ -6,6 +6,7 @@ import json
 
 import numpy as np
 import pytest
+from conftest import ROOT
 
 from align.alignment import Plan, align
 from align.alignment.job import AlignmentResult
@@ -13,7 +14,6 @@ from align.errors import InputError
 from align.io import read_log, read_toml
 from align.results import KNOWN, load_result, result_from_dict, save_result
 from align.values import approx_equal
-from conftest import ROOT
 
 
 @pytest.fixture(scope="module")

@@ -1,7 +1,8 @@
 """Mount inputs shared by the mechanics tests: the reference's Example 1 (optionally edited)."""
 
-from align.io import read_toml
 from conftest import ROOT
+
+from align.io import read_toml
 from mechanics.mount import Mount, mount_from_dict
 
 EXAMPLE1 = ROOT / "examples" / "budget" / "example1.toml"

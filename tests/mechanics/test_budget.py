@@ -4,6 +4,7 @@ import json
 
 import numpy as np
 import pytest
+from mounts import EXAMPLE1, example1
 
 from align.errors import InputError
 from align.io import read_toml
@@ -14,7 +15,6 @@ from mechanics.budget import Budget, budget
 from mechanics.formulas import rss, screw_radius
 from mechanics.montecarlo import monte_carlo
 from mechanics.mount import mount_from_dict
-from mounts import EXAMPLE1, example1
 
 
 def test_position_tolerance_widens_the_skew():

@@ -2,10 +2,10 @@
 
 import numpy as np
 import pytest
+from mounts import example1
 
 from mechanics.budget import budget
 from mechanics.formulas import rss, screw_radius, skew_from_screws, tilt_from_ledges
-from mounts import example1
 
 
 def test_example1_source_numbers():

@@ -2,11 +2,11 @@
 
 import numpy as np
 import pytest
+from mounts import example1
 
 from align.values import approx_equal
 from mechanics.budget import budget
 from mechanics.montecarlo import MonteCarlo, monte_carlo
-from mounts import example1
 
 
 def test_worst_case_bounds_monte_carlo_and_is_approached():

@@ -2,11 +2,11 @@
 
 import numpy as np
 import pytest
+from mounts import example1
 
 from align.errors import InputError
 from align.values import approx_equal
 from mechanics.mount import Mount, corner_ledges
-from mounts import example1
 
 
 @pytest.mark.parametrize("section,field,value,words", [

@@ -3,11 +3,11 @@
 import math
 
 import pytest
+from mounts import example1
 
 from mechanics.budget import budget
 from mechanics.montecarlo import monte_carlo
 from mechanics.render import assembly_glb, assembly_png, histogram_png, resting_pose
-from mounts import example1
 
 PNG = b"\x89PNG\r\n\x1a\n"
 

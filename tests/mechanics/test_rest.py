@@ -2,13 +2,13 @@
 
 import numpy as np
 import pytest
+from mounts import EXAMPLE1
 from scipy.optimize import linprog
 
 from align.io import read_toml
 from mechanics.formulas import tilt_from_ledges
 from mechanics.mount import mount_from_dict
 from mechanics.rest import corner_geometry, plane_tilt, rest_plane_hull, rest_planes
-from mounts import EXAMPLE1
 
 
 def _corner_pads(L=0.047, W=0.044, s=0.006):

@@ -5,7 +5,8 @@ import pytest
 
 from align.noise import fit, planner
 from align.noise.model import FLICKER_FACTOR, TERMS, NoiseModel, avar_design, model_adev
-from align.units import DEG_H, parse_quantity as q
+from align.units import DEG_H
+from align.units import parse_quantity as q
 from align.values import approx_equal
 
 ARW = q("0.3 deg/sqrt(h)", "angle_random_walk")

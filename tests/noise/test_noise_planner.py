@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from align.noise.planner import averaging_time, model_curve, noise_target
-from align.units import DEG_H, parse_quantity as q
+from align.units import DEG_H
+from align.units import parse_quantity as q
 
 ARW = q("0.3 deg/sqrt(h)", "angle_random_walk")
 

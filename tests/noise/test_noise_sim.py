@@ -2,11 +2,11 @@
 
 import numpy as np
 import pytest
+from test_noise_fit import ARW, _fit  # simulate, then fit: the simulator checked by the fit
 
 from align.noise.fit import noise_figures
 from align.noise.sim import NoiseSpec, seed_method_a, seed_method_b, seed_restoring, simulate_noise
 from align.units import parse_quantity as q
-from test_noise_fit import ARW, _fit  # simulate, then fit: the simulator checked by the fit
 
 
 def test_simulator_checks_itself_other_terms():

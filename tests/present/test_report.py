@@ -55,7 +55,8 @@ def test_report_is_self_contained_and_every_picture_decodes(demo_dir):
 @pytest.mark.skipif(shutil.which("chromium") is None, reason="Chromium not installed (CI installs it)")
 def test_report_in_headless_chromium(demo_dir, tmp_path):
     page = (demo_dir[0] / "report.html").read_text()
-    probe = ("<script>window.addEventListener('load',()=>{const bad=[...document.images].filter(i=>!(i.complete&&i.naturalWidth>0));"
+    probe = ("<script>window.addEventListener('load',()=>{"
+             "const bad=[...document.images].filter(i=>!(i.complete&&i.naturalWidth>0));"
              "document.title='images '+document.images.length+' broken '+bad.length;});</script></body>")
     checked = tmp_path / "checked.html"
     checked.write_text(page.replace("</body>", probe))
@@ -67,7 +68,8 @@ def test_report_in_headless_chromium(demo_dir, tmp_path):
     assert "<title>images 3 broken 0</title>" in res.stdout
     assert "CONSOLE" not in res.stderr and "Uncaught" not in res.stderr
     shot = tmp_path / "shot.png"
-    subprocess.run(["chromium", *flags, "--window-size=1100,2000", f"--screenshot={shot}", (demo_dir[0] / "report.html").as_uri()],
+    page_uri = (demo_dir[0] / "report.html").as_uri()
+    subprocess.run(["chromium", *flags, "--window-size=1100,2000", f"--screenshot={shot}", page_uri],
                    capture_output=True, timeout=120)
     from PIL import Image
 
@@ -84,7 +86,8 @@ def test_report_command_errors(tmp_path, run_cli):
 
 
 def test_start_up_imports_nothing_heavy():
-    code = "import sys, align.cli; print(sorted(m for m in ('numpy', 'scipy', 'matplotlib', 'numba', 'sympy', 'trimesh') if m in sys.modules))"
+    heavy = ('numpy', 'scipy', 'matplotlib', 'numba', 'sympy', 'trimesh')
+    code = f"import sys, align.cli; print(sorted(m for m in {heavy!r} if m in sys.modules))"
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert res.stdout.strip() == "[]"
 

@@ -5,6 +5,7 @@ import json
 
 import numpy as np
 import pytest
+from conftest import ROOT
 
 from align.io import read_toml
 from align.results import load_result, save_result
@@ -13,7 +14,6 @@ from align.sensitivity.manoeuvre import manoeuvre_from_dict
 from align.sensitivity.symbolic import ELEMENTS
 from align.units import DEG
 from align.values import approx_equal
-from conftest import ROOT
 from mechanics.budget import budget
 from mechanics.mount import mount_from_dict
 

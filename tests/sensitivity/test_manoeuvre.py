@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from conftest import ROOT
 
 from align.errors import InputError
 from align.io import read_toml
@@ -9,7 +10,6 @@ from align.sensitivity.allowable import allowable
 from align.sensitivity.manoeuvre import Manoeuvre, manoeuvre_from_dict
 from align.units import DEG
 from align.values import approx_equal
-from conftest import ROOT
 
 EXAMPLE2 = ROOT / "examples" / "sensitivity" / "example2.toml"
 
