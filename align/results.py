@@ -6,8 +6,8 @@ envelope::
     {"format": "imu-align.alignment", "version": 1, "generator": "imu-align 0.2.0",
      "convention": "g = M w + b; ...", "units": {...}, ...body...}
 
-A result type is a frozen :class:`Result` dataclass that names its ``FORMAT``,
-``VERSION`` and ``CONVENTION``, writes itself with :meth:`Result.to_dict`
+A result type is a :class:`Result` subclass that names its format, version and
+convention in its class statement, writes itself with :meth:`Result.to_dict`
 (through :meth:`Result.envelope`) and reads itself back with
 :meth:`Result.from_dict` (which first calls :meth:`Result.check_envelope`).
 :func:`load_result` picks the type from the file's ``format`` and refuses an
@@ -17,20 +17,22 @@ atomically. A new result type adds one line to :data:`KNOWN`.
 
 Public names
 ------------
-Result, Correction, KNOWN, register, envelope, load_result, result_from_dict, save_result
+Result, Correction, KNOWN, register, envelope, file_unit, load_result, result_from_dict, save_result
 """
 
 from __future__ import annotations
 
 import importlib
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, ClassVar, Protocol
+from typing import Any, ClassVar, Protocol, dataclass_transform
 
 import numpy as np
 
 from align import __version__
 from align.errors import InputError
 from align.io.files import read_json, write_json
+from align.units import parse_unit
 from align.values import Value
 
 #: every result format -> the module that defines (and registers) its type
@@ -68,11 +70,20 @@ class Correction(Protocol):
 
 
 def register(cls: type[Result]) -> type[Result]:
-    """Class decorator: make ``cls`` the type :func:`load_result` returns for ``cls.FORMAT``."""
+    """Make ``cls`` the type :func:`load_result` returns for ``cls.FORMAT`` (done for every Result subclass)."""
     if cls.FORMAT not in KNOWN:
         raise ValueError(f"{cls.FORMAT} is not listed in align.results.KNOWN")
     _TYPES[cls.FORMAT] = cls
     return cls
+
+
+def file_unit(d: dict[str, Any], key: str, expect: str | None, where: str) -> tuple[str, float]:
+    """The unit a result file states for ``key`` (``d["units"][key]``) and its factor to SI.
+
+    Raises KeyError when the file states none (the caller reports a malformed file).
+    """
+    unit = d["units"][key]
+    return unit, parse_unit(unit, expect, f"{where}: units.{key}").factor
 
 
 def envelope(format: str, version: int, convention: str, units: dict[str, str] | None = None) -> dict[str, Any]:
@@ -81,17 +92,31 @@ def envelope(format: str, version: int, convention: str, units: dict[str, str] |
             "convention": convention, "units": dict(units or {})}
 
 
+@dataclass_transform(frozen_default=True, eq_default=False)
 class Result(Value):
-    """Base of every result type (a frozen dataclass, see :class:`~align.values.Value`).
+    """Base of every result type: a frozen value (see :class:`~align.values.Value`) that is a file.
 
-    Subclasses set ``FORMAT``, ``VERSION`` and ``CONVENTION`` and implement
-    ``to_dict`` (calling :meth:`envelope`) and ``from_dict`` (calling
-    :meth:`check_envelope`); ``from_dict(to_dict(r)) == r``.
+    A subclass names its file format in its class statement and is made a frozen
+    dataclass and registered for :func:`load_result` there::
+
+        class AlignmentResult(Result, format="imu-align.alignment", convention=CONVENTION):
+            method: str
+            M: np.ndarray
+            ...
+
+    It implements ``to_dict`` (starting with :meth:`envelope`) and ``from_dict``
+    (starting with :meth:`check_envelope`), so that ``from_dict(to_dict(r)) == r``.
     """
 
     FORMAT: ClassVar[str]
     VERSION: ClassVar[int] = 1
     CONVENTION: ClassVar[str]
+
+    def __init_subclass__(cls, format: str, convention: str, version: int = 1, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        cls.FORMAT, cls.VERSION, cls.CONVENTION = format, version, convention
+        dataclass(frozen=True, eq=False)(cls)
+        register(cls)
 
     def envelope(self, units: dict[str, str] | None = None) -> dict[str, Any]:
         """The envelope of this result (see :func:`envelope`)."""

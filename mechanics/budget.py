@@ -21,14 +21,13 @@ Budget, budget, FORMAT, BASES
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import ClassVar
+from dataclasses import field
 
 import numpy as np
 
 from align import CONVENTION
 from align.errors import InputError
-from align.results import Result, register
+from align.results import Result
 from align.units import DEG
 from mechanics.assembly import skew_limit, worst_case_per_axis
 from mechanics.formulas import rss, screw_radius, skew_from_screws, tilt_from_ledges
@@ -36,6 +35,7 @@ from mechanics.montecarlo import MonteCarlo
 from mechanics.mount import Mount
 
 FORMAT = "imu-align.budget"
+BUDGET_CONVENTION = CONVENTION + "; misalignment = angle between each gyro axis and its system axis"
 #: budget figures :meth:`Budget.elements` can give
 BASES = ("rss", "worst")
 
@@ -48,9 +48,7 @@ def _xyz_rad(d: dict) -> np.ndarray:
     return np.array([d[a] for a in "xyz"], dtype=float) * DEG
 
 
-@register
-@dataclass(frozen=True, eq=False)
-class Budget(Result):
+class Budget(Result, format=FORMAT, convention=BUDGET_CONVENTION):
     """The mounting-misalignment budget of a mount (all angles in rad).
 
     Attributes
@@ -91,9 +89,6 @@ class Budget(Result):
     monte_carlo: MonteCarlo | None = None
     inputs: dict = field(default_factory=dict)
 
-    FORMAT: ClassVar[str] = FORMAT
-    VERSION: ClassVar[int] = 1
-    CONVENTION: ClassVar[str] = CONVENTION + "; misalignment = angle between each gyro axis and its system axis"
 
     @property
     def worst_case(self) -> float:

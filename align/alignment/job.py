@@ -12,7 +12,6 @@ AlignOptions, AlignmentResult, SegmentReport, align, FORMAT, FORMAT_VERSION
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import ClassVar
 
 import numpy as np
 
@@ -41,7 +40,7 @@ from align.earth import EARTH_RATE, vertical_rate
 from align.errors import InputError
 from align.io import c_header, check_log
 from align.model import Angles, SensorModel, angles, check_handedness
-from align.results import Result, register
+from align.results import Result, file_unit
 from align.units import DEG, DEG_H, parse_unit, to_unit
 from align.values import Value
 
@@ -101,9 +100,7 @@ class SegmentReport(Value):
     noise: tuple[float, float, float]
 
 
-@register
-@dataclass(frozen=True, eq=False)
-class AlignmentResult(Result):
+class AlignmentResult(Result, format=FORMAT, version=FORMAT_VERSION, convention=CONVENTION):
     """Result of an electronic alignment (``g = M w + b``, ``w = A (g - b)``).
 
     ``bias`` and ``sigma_bias`` are rad/s; ``M``, ``A`` and their sigmas are
@@ -126,9 +123,6 @@ class AlignmentResult(Result):
     inferred_axis: int | None = None
     inputs: dict = field(default_factory=dict)
 
-    FORMAT: ClassVar[str] = FORMAT
-    VERSION: ClassVar[int] = FORMAT_VERSION
-    CONVENTION: ClassVar[str] = CONVENTION
 
     @property
     def angles(self) -> Angles:
@@ -204,8 +198,7 @@ class AlignmentResult(Result):
         """Read the form written by :meth:`to_dict` (any version up to the current one)."""
         cls.check_envelope(d, where)
         try:
-            u = d["units"]["bias"]
-            f = parse_unit(u, "angular_rate", f"{where}: units.bias").factor
+            u, f = file_unit(d, "bias", "angular_rate", where)
             m = np.array(d["M"], float).reshape(3, 3)
             unc = d.get("uncertainty", {})
             segs = tuple(

@@ -208,12 +208,8 @@ def segment_log(
             hint = unit_mixup_hint(float(np.median(biggest)) / float(np.median([abs(s.rate) for s in plan.steps])))
             if runs and hint:
                 raise TestError(hint, where)
-            raise TestError(
-                f"found {len(moving)} constant-rate dwells but the plan has {len(plan.steps)} steps; "
-                f"dwells found: {_describe(g, t, moving) or 'none'}; "
-                "check the plan, {window}/{min_dwell}, or give {segments}",
-                where,
-            )
+            raise _count_error("constant-rate dwells", len(moving), plan, f"dwells found: {_describe(g, t, moving) or 'none'}",
+                               "check the plan, {window}/{min_dwell}, or give {segments}", where)
         segs = [Segment(f"step {k + 1} ({s.label})", "rate", a, b, k) for k, (s, (a, b)) in enumerate(zip(plan.steps, moving))]
     else:
         is_static, _ = _classify(g, runs, opts.static_threshold)
@@ -227,17 +223,19 @@ def segment_log(
                 turns.append((e0, s1))
         if len(turns) != len(plan.steps):
             found = "; ".join(f"t={t[a]:.2f}-{t[b - 1]:.2f} s" for a, b in turns) or "none"
-            raise TestError(
-                f"found {len(turns)} turns between static periods but the plan has {len(plan.steps)} steps "
-                f"(turns found: {found}; static periods: {len(statics)}); each turn must start and end at rest "
-                "(check {static_threshold}, or give {segments})",
-                where,
-            )
+            raise _count_error("turns between static periods", len(turns), plan,
+                               f"turns found: {found}; static periods: {len(statics)}",
+                               "each turn must start and end at rest (check {static_threshold}, or give {segments})", where)
         segs = [Segment(f"step {k + 1} ({s.label})", "angle", a, b, k) for k, (s, (a, b)) in enumerate(zip(plan.steps, turns))]
         moving = turns
     statics = [r for r, st in zip(runs, is_static) if st]
     segs += [Segment(f"static {k + 1}", "static", a, b) for k, (a, b) in enumerate(statics)]
     return segs
+
+
+def _count_error(what: str, found: int, plan: Plan, detail: str, advice: str, where: str) -> TestError:
+    """The segmentation found another number of steps than the plan lists."""
+    return TestError(f"found {found} {what} but the plan has {len(plan.steps)} steps; {detail}; {advice}", where)
 
 
 def _merge_similar(g: np.ndarray, runs: list[tuple[int, int]], tol: float, max_gap: int) -> list[tuple[int, int]]:

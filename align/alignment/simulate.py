@@ -15,7 +15,6 @@ SessionSpec, simulate_session, random_model, SimulationTruth
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import ClassVar
 
 import numpy as np
 
@@ -24,8 +23,8 @@ from align.alignment.plan import Plan
 from align.earth import earth_rate_in_frame
 from align.errors import InputError
 from align.model import SensorModel
-from align.results import Result, register
-from align.units import DEG, DEG_S, parse_unit, to_unit
+from align.results import Result, file_unit
+from align.units import DEG, DEG_S, to_unit
 
 
 @dataclass(frozen=True)
@@ -163,9 +162,7 @@ def random_model(rng: np.random.Generator, misalignment: float, scale_sd: float 
                                      delta=rng.normal(0, delta_sd, 3), bias=rng.normal(0, bias_sd, 3))
 
 
-@register
-@dataclass(frozen=True, eq=False)
-class SimulationTruth(Result):
+class SimulationTruth(Result, format="imu-align.truth", convention=CONVENTION):
     """The true model of a simulated session (``truth.json``), to compare an alignment with.
 
     Attributes
@@ -178,10 +175,6 @@ class SimulationTruth(Result):
         The simulation's random seed.
     inputs : dict
     """
-
-    FORMAT: ClassVar[str] = "imu-align.truth"
-    VERSION: ClassVar[int] = 1
-    CONVENTION: ClassVar[str] = CONVENTION
 
     model: SensorModel
     units: str = "deg/s"
@@ -197,8 +190,7 @@ class SimulationTruth(Result):
     def from_dict(cls, d: dict, where: str = "truth") -> SimulationTruth:
         cls.check_envelope(d, where)
         try:
-            u = d["units"]["bias"]
-            f = parse_unit(u, "angular_rate", f"{where}: units.bias").factor
+            u, f = file_unit(d, "bias", "angular_rate", where)
             return cls(SensorModel(np.array(d["M"], float), np.array(d["bias"], float) * f), u, d.get("seed"),
                        dict(d.get("inputs", {})))
         except (KeyError, TypeError, ValueError) as exc:

@@ -24,25 +24,21 @@ MODELS, FORMAT, CONVENTION
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from dataclasses import field as dataclass_field
-from typing import ClassVar
 
 import numpy as np
 
 from align.calibration.ellipsoid import MODELS, algebraic_fit, pack, unpack
 from align.errors import InputError, TestError
 from align.io import check_finite
-from align.results import Result, register
-from align.units import DEG, parse_unit, to_unit
+from align.results import Result, file_unit
+from align.units import DEG, to_unit
 
 FORMAT = "imu-align.magnetometer"
 CONVENTION = "m_cal = soft_iron (m_raw - hard_iron)"
 
 
-@register
-@dataclass(frozen=True, eq=False)
-class MagCalibration(Result):
+class MagCalibration(Result, format=FORMAT, convention=CONVENTION):
     """A magnetometer calibration, ``m_cal = soft_iron (m_raw - hard_iron)``.
 
     Attributes
@@ -71,10 +67,6 @@ class MagCalibration(Result):
     inputs : dict
         The files and settings the calibration came from.
     """
-
-    FORMAT: ClassVar[str] = FORMAT
-    VERSION: ClassVar[int] = 1
-    CONVENTION: ClassVar[str] = CONVENTION
 
     hard_iron: np.ndarray
     soft_iron: np.ndarray
@@ -136,8 +128,7 @@ class MagCalibration(Result):
         """Read the form written by :meth:`to_dict` (any version up to the current one)."""
         cls.check_envelope(d, where)
         try:
-            u = d["units"]["hard_iron"]
-            f = parse_unit(u, where=f"{where}: units.hard_iron").factor
+            u, f = file_unit(d, "hard_iron", None, where)
             q = d["quality"]
             mis = d.get("misalignment")
             return cls(

@@ -16,14 +16,13 @@ Calibration, CalibrationSet, SENSORS, FORMAT, CONVENTION
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import ClassVar
 
 import numpy as np
 
 from align.errors import InputError
 from align.io.export import imucal_dict
-from align.results import Result, register
-from align.units import parse_unit, to_unit
+from align.results import Result, file_unit
+from align.units import to_unit
 from align.values import Value, frozen_array
 
 FORMAT = "imu-align.calibration"
@@ -97,8 +96,7 @@ class Calibration(Value):
     def from_dict(cls, d: dict, where: str = "calibration") -> Calibration:
         """Read the form written by :meth:`to_dict`."""
         try:
-            u = d["units"]["bias"]
-            f = parse_unit(u, where=f"{where}: units.bias").factor
+            u, f = file_unit(d, "bias", None, where)
             unc = d.get("uncertainty", {})
             gs = d.get("g_sensitivity")
             return cls(
@@ -133,9 +131,7 @@ class Calibration(Value):
         return np.linalg.solve(self.M, (np.asarray(raw) - off).T).T
 
 
-@register
-@dataclass(frozen=True, eq=False)
-class CalibrationSet(Result):
+class CalibrationSet(Result, format=FORMAT, convention=CONVENTION):
     """The calibration file: one session's accelerometer and/or gyroscope.
 
     Attributes
@@ -145,10 +141,6 @@ class CalibrationSet(Result):
     inputs : dict
         The files and settings the calibration came from.
     """
-
-    FORMAT: ClassVar[str] = FORMAT
-    VERSION: ClassVar[int] = 1
-    CONVENTION: ClassVar[str] = CONVENTION
 
     sensors: dict
     inputs: dict = field(default_factory=dict)

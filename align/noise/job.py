@@ -15,8 +15,7 @@ AllanJob, run_allan, read_runs, plan_from_allan, term_units, FORMAT
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 
@@ -25,10 +24,12 @@ from align.noise.allan import NOISE_ALPHA, AllanResult, allan, edf_overlapping
 from align.noise.fit import NoiseFit, fit_noise
 from align.noise.model import TERMS, avar_design
 from align.noise.planner import PlanResult, make_plan
-from align.results import Result, register
+from align.results import Result, file_unit
 from align.units import parse_unit, to_unit
 
 FORMAT = "imu-align.allan"
+CONVENTION = ("overlapping Allan deviation (IEEE Std 1139, NIST SP 1065); noise model "
+              "sigma^2(tau) = 3 Q^2/tau^2 + N^2/tau + (2 ln 2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2 (IEEE Std 952)")
 
 #: display units of the five terms for gyros and accelerometers
 _GYRO = ("deg", "deg/sqrt(h)", "deg/h", "deg/h/sqrt(h)", "deg/h^2")
@@ -47,9 +48,7 @@ def term_units(units: str) -> tuple[str, ...]:
     return _GYRO if u.dim == parse_unit("rad/s").dim else _ACCEL
 
 
-@register
-@dataclass(frozen=True, eq=False)
-class AllanJob(Result):
+class AllanJob(Result, format=FORMAT, convention=CONVENTION):
     """Result of :func:`run_allan` (SI inside; ``units`` is the input unit).
 
     Attributes
@@ -80,12 +79,6 @@ class AllanJob(Result):
     runs: int
     inputs: tuple = ()
     plan: PlanResult | None = None
-
-    FORMAT: ClassVar[str] = FORMAT
-    VERSION: ClassVar[int] = 1
-    CONVENTION: ClassVar[str] = ("overlapping Allan deviation (IEEE Std 1139, NIST SP 1065); noise model "
-                                 "sigma^2(tau) = 3 Q^2/tau^2 + N^2/tau + (2 ln 2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2 "
-                                 "(IEEE Std 952)")
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -155,8 +148,7 @@ class AllanJob(Result):
         ``dominant`` and ``adev_run_figures`` were added read too: those are rebuilt)."""
         cls.check_envelope(d, where)
         try:
-            u = d["units"]["adev"]
-            f = parse_unit(u, None, f"{where}: units.adev").factor
+            u, f = file_unit(d, "adev", None, where)
             tu = term_units(u)
             names = tuple(d["adev"])
             fs, n, runs = float(d["fs_hz"]), int(d["samples"]), int(d["runs"])

@@ -17,18 +17,20 @@ PlanResult, Averaging, noise_target, model_curve, averaging_time, longest_turn, 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 
 from align.errors import InputError
 from align.noise.model import NoiseModel
 from align.parts import Part
-from align.results import Result, register
+from align.results import Result
 from align.units import DEG, DEG_H
 from align.values import Value
 
 FORMAT = "imu-align.plan"
+CONVENTION = ("noise target = rate sin(accuracy) / noise_ratio (Example 3); averaging time: "
+              "shortest tau with sigma(tau) <= target on the falling branch of the Allan deviation")
 
 
 def noise_target(rate: float, accuracy: float, ratio: float = 10.0) -> float:
@@ -120,9 +122,7 @@ def longest_turn(angle_target: float, sigma, t_max: float = 1e5) -> float | None
     return float(np.exp(brentq(g, np.log(1e-6), np.log(t_max), xtol=1e-12)))
 
 
-@register
-@dataclass(frozen=True, eq=False)
-class PlanResult(Result):
+class PlanResult(Result, format=FORMAT, convention=CONVENTION):
     """A test plan from the noise (SI units: rad/s, rad, s).
 
     Attributes
@@ -160,10 +160,6 @@ class PlanResult(Result):
     source: str
     inputs: dict = field(default_factory=dict)
 
-    FORMAT: ClassVar[str] = FORMAT
-    VERSION: ClassVar[int] = 1
-    CONVENTION: ClassVar[str] = ("noise target = rate sin(accuracy) / noise_ratio (Example 3); averaging time: "
-                                 "shortest tau with sigma(tau) <= target on the falling branch of the Allan deviation")
 
     @property
     def dwell(self) -> float | None:

@@ -20,18 +20,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import ClassVar
 
 import numpy as np
 
 from align import CONVENTION
 from align.errors import InputError
-from align.results import Result, register
+from align.results import Result
 from align.sensitivity.attitude import closed_form_errors, output_errors
 from align.sensitivity.manoeuvre import Manoeuvre
 from align.sensitivity.symbolic import ELEMENTS, matrix_from_angles
 from align.units import DEG
 from align.values import Value
+
+ALLOWABLE_CONVENTION = CONVENTION + "; M_ii = cos(psi_i), M_ij = sin(phi_ij) (Eq 5-10)"
 
 
 def _deg(v: float) -> float | None:
@@ -44,9 +45,7 @@ def _rad(v: float | None) -> float:
     return math.inf if v is None else float(v) * DEG
 
 
-@register
-@dataclass(frozen=True, eq=False)
-class Allowable(Result):
+class Allowable(Result, format="imu-align.allowable", convention=ALLOWABLE_CONVENTION):
     """Allowable misalignment per element of a manoeuvre.
 
     Attributes
@@ -81,10 +80,6 @@ class Allowable(Result):
     agreement: dict
     manoeuvre: Manoeuvre
     inputs: dict = field(default_factory=dict)
-
-    FORMAT: ClassVar[str] = "imu-align.allowable"
-    VERSION: ClassVar[int] = 1
-    CONVENTION: ClassVar[str] = CONVENTION + "; M_ii = cos(psi_i), M_ij = sin(phi_ij) (Eq 5-10)"
 
     def to_dict(self) -> dict:
         """The versioned JSON form, angles in deg (``None`` for unconstrained)."""
@@ -279,9 +274,7 @@ def margins(predicted: dict, allow: Allowable) -> list[Margin]:
     return [Margin(e, float(predicted[e]), float(allow.allowable[e])) for e in ELEMENTS]
 
 
-@register
-@dataclass(frozen=True, eq=False)
-class MarginTable(Result):
+class MarginTable(Result, format="imu-align.check", convention=CONVENTION):
     """The budget against the allowance, element by element (iterates over its rows).
 
     Attributes
@@ -296,10 +289,6 @@ class MarginTable(Result):
     basis: str
     rows: tuple[Margin, ...]
     inputs: dict = field(default_factory=dict)
-
-    FORMAT: ClassVar[str] = "imu-align.check"
-    VERSION: ClassVar[int] = 1
-    CONVENTION: ClassVar[str] = CONVENTION
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "rows", tuple(self.rows))
