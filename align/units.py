@@ -272,7 +272,7 @@ def format_quantity(value_si: float, unit: str, digits: int = 6) -> str:
 _MIXUPS = ((180 / math.pi, "the log looks like deg/s read as rad/s: set {gyro_units=deg/s}"),
            (math.pi / 180, "the log looks like rad/s read as deg/s: set {gyro_units=rad/s}"),
            (1e3, "mdps read as deg/s? set {gyro_units=mdps}"),
-           (1e-3, "deg/s read as mdps? check {gyro_units}"))
+           (1e-3, "deg/s read as mdps? set {gyro_units=deg/s}"))
 
 
 def unit_mixup_hint(ratio: float) -> str | None:

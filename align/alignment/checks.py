@@ -23,10 +23,13 @@ from align.errors import HandednessError, TestError
 from align.units import format_quantity, unit_mixup_hint
 from align.values import Value
 
+#: the status of a check that could not run
+NOT_CHECKED = "not checked"
+
 
 @dataclass(frozen=True, eq=False)
 class Check(Value):
-    """One check's outcome: ``status`` is ``"pass"`` or ``"warn"``."""
+    """One check's outcome: ``status`` is ``"pass"``, ``"warn"`` or ``"not checked"`` (what it needed was not given)."""
 
     name: str
     status: str
@@ -63,7 +66,7 @@ def check_span(plan: Plan, allow_two_axis: bool = False) -> int | None:
 def check_saturation(g: np.ndarray, segments: list[Segment], gyro_range: float | None, units: str) -> Check:
     """No sample used in a segment may reach 99 % of the stated gyro range."""
     if gyro_range is None:
-        return Check("saturation", "pass", "no gyro range stated ({gyro_range})")
+        return Check("saturation", NOT_CHECKED, "no gyro range given: saturation not checked")
     limit = 0.99 * gyro_range
     for seg in segments:
         peak = float(np.max(np.abs(g[seg.start : seg.end])))
@@ -90,7 +93,8 @@ def check_durations(segments: list[Segment], fs: float, min_duration: float, min
     return Check("durations", "pass", f"every step at least {min_duration:g} s")
 
 
-def check_directions(measured: list[tuple[Segment, float, float]], plan: Plan, tolerance: float, units: str) -> Check:
+def check_directions(measured: list[tuple[Segment, float, float]], plan: Plan, tolerance: float, units: str,
+                     where: str = "log") -> Check:
     """Compare each step's measured turn with the plan.
 
     Parameters
@@ -110,7 +114,7 @@ def check_directions(measured: list[tuple[Segment, float, float]], plan: Plan, t
     signed = planned * np.array([s.sign for s in steps])  # turn about the positive system axis
     hint = unit_mixup_hint(float(np.median(np.abs(ratios))))
     if hint:
-        raise TestError(hint, "log")
+        raise TestError(hint, where)
     for axis in range(3):
         on = np.array([s.axis == axis for s in steps])
         if len(set(np.sign(signed[on]))) == 2 and np.all(ratios[on] < 0):
@@ -118,7 +122,7 @@ def check_directions(measured: list[tuple[Segment, float, float]], plan: Plan, t
                 f"every step about {'xyz'[axis]}, in both directions, measured reversed: the {'xyz'[axis]} gyro reads "
                 "backwards (det(M) < 0, a handedness error) or the plan's axis signs are wrong; fix the wiring or sign, "
                 "the tool does not flip it",
-                "log",
+                where,
             )
     for (seg, along, across), ratio, step, value in zip(measured, ratios, steps, planned):
         unit = units if step.rate is not None else "deg"
@@ -142,7 +146,7 @@ def check_directions(measured: list[tuple[Segment, float, float]], plan: Plan, t
     return Check("directions", "pass", f"every step within {100 * tolerance:g} % of the plan, in the planned direction")
 
 
-def check_scale(m: np.ndarray, tolerance: float) -> Check:
+def check_scale(m: np.ndarray, tolerance: float, where: str = "result") -> Check:
     """Scale factors ``|M[i, :]|`` must lie within ``1 +/- tolerance``."""
     scale = np.linalg.norm(m, axis=1)
     for i, s in enumerate(scale):
@@ -150,7 +154,7 @@ def check_scale(m: np.ndarray, tolerance: float) -> Check:
             raise TestError(
                 f"gyro {'xyz'[i]} scale factor {s:.4f} is outside 1 +/- {tolerance:g}: wrong gyro units, "
                 "wrong table rate, or a broken gyro (raise {scale_tolerance} if this is expected)",
-                "result",
+                where,
             )
     return Check("scale", "pass", f"scale factors {', '.join(f'{s:.5f}' for s in scale)} within 1 +/- {tolerance:g}")
 

@@ -296,7 +296,7 @@ def align(
     obs = observe(t, g, segments, plan, sigma, earth)
     statics = [o for o in obs if o.segment.kind == "static"]
     rough_bias = (np.mean([o.y for o in statics], axis=0) if statics else np.zeros(3))
-    checks.append(check_directions(_measured_turns(obs, plan, rough_bias), plan, options.rate_tolerance, units))
+    checks.append(check_directions(_measured_turns(obs, plan, rough_bias), plan, options.rate_tolerance, units, where))
     used = obs if plan.kind != "rate" else [o for o in obs if o.segment.kind != "static"]
     if method == "rate":
         fit = fit_rate_pairs(used, plan)
@@ -317,8 +317,8 @@ def align(
             f"and the column's direction by up to {bound / DEG:.4g} deg"
         )
         fit = replace(fit, M=m, sigma_M=sigma_m)
-    check_handedness(m, "result")
-    checks.append(check_scale(m, options.scale_tolerance))
+    check_handedness(m, f"{where}: result")
+    checks.append(check_scale(m, options.scale_tolerance, f"{where}: result"))
     cov = fit.cov.copy()
     if method == "two-axis":
         for i in range(3):

@@ -16,6 +16,7 @@ check_outputs, output_folder, save_json
 from __future__ import annotations
 
 import os
+import tempfile
 from collections.abc import Iterable
 from pathlib import Path
 
@@ -36,11 +37,23 @@ def _check_file(field: str, path: Path, inputs: list[Path]) -> None:
     if path.is_dir():
         raise InputError(f"{path} is a folder; give a file name", where)
     parent = path.parent
+    if parent.exists() and not parent.is_dir():
+        raise InputError(f"{parent} is a file, not a folder; give a path in a folder", where)
     if not parent.is_dir():
         raise InputError(f"folder {parent} does not exist; create it first", where)
+    _writable(parent, where)
     for p in inputs:
         if _same(path, p):
             raise InputError(f"{path} is also an input of this command; write to another file", where)
+
+
+def _writable(folder: Path, where: str) -> None:
+    """Refuse a folder in which no file can be created (tried with an unnamed temporary file)."""
+    try:
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as exc:
+        raise InputError(f"cannot write in {folder} ({exc.strerror or exc}); choose another folder", where) from None
 
 
 def check_outputs(inputs: Iterable[Path | None] = (), folder: tuple[str, Path, Iterable[str]] | None = None,

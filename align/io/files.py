@@ -61,15 +61,20 @@ def _atomic(path: str | Path, write) -> None:
     p = Path(path)
     if p.parent and not p.parent.exists():
         raise InputError("output folder does not exist", str(path))
-    fd, tmp = tempfile.mkstemp(dir=p.parent or ".", prefix=f".{p.name}.", suffix=".tmp")
+    try:
+        fd, tmp = tempfile.mkstemp(dir=p.parent or ".", prefix=f".{p.name}.", suffix=".tmp")
+    except OSError as exc:
+        raise InputError(f"cannot write here ({exc.strerror or exc}); choose another folder", str(path)) from None
     try:
         with os.fdopen(fd, "wb") as fh:
             write(fh)
         os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, p)
-    except BaseException:
+    except BaseException as exc:
         if os.path.exists(tmp):
             os.unlink(tmp)
+        if isinstance(exc, OSError):
+            raise InputError(f"cannot write ({exc.strerror or exc}); nothing was written", str(path)) from None
         raise
 
 

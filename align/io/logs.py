@@ -38,7 +38,7 @@ def check_time(t: np.ndarray, where: str, gap: float | None = None, jitter: bool
     dt = np.diff(t)
     if np.any(dt <= 0):
         k = int(np.argmax(dt <= 0))
-        raise InputError(f"time does not increase at data row {k + 2} (t={t[k + 1]!r} after {t[k]!r}); "
+        raise InputError(f"time does not increase at data row {k + 2} (t={t[k + 1]:.9g} s after {t[k]:.9g} s); "
                          "sort the log or fix the time column", where)
     if gap is None or len(dt) == 0:
         return
@@ -59,7 +59,8 @@ def check_log(t: np.ndarray, g: np.ndarray, where: str, min_rows: int = 10) -> N
     check_time(t, where)
 
 
-def read_columns(path: str | Path, names: list[str] | None = None) -> tuple[list[str], np.ndarray]:
+def read_columns(path: str | Path, names: list[str] | None = None,
+                 time_column: str | None = None) -> tuple[list[str], np.ndarray]:
     """Read named numeric columns of a CSV (.csv, .csv.gz), .parquet or .npy file.
 
     Parameters
@@ -69,6 +70,8 @@ def read_columns(path: str | Path, names: list[str] | None = None) -> tuple[list
         Columns to read (all when None). For .npy files (no names) the columns
         are taken in order and named ``col0, col1, ...`` unless ``names``
         matches the array's width.
+    time_column : str, optional
+        The name among ``names`` that is the time (a missing one then points to the sample rate).
 
     Returns
     -------
@@ -100,7 +103,7 @@ def read_columns(path: str | Path, names: list[str] | None = None) -> tuple[list
             schema_names = pq.read_schema(p).names
         except Exception as exc:  # pyarrow raises several types for a bad file
             raise InputError(f"cannot read parquet ({exc})", str(path)) from None
-        _require(names, schema_names, path)
+        _require(names, schema_names, path, time_column)
         table = pq.read_table(p, columns=names)
         table = table.cast(pa.schema([(n, pa.float64()) for n in table.column_names]))
     elif _is_whitespace_table(p):
@@ -114,7 +117,7 @@ def read_columns(path: str | Path, names: list[str] | None = None) -> tuple[list
                 header = reader.schema.names
         except (pa.ArrowInvalid, OSError) as exc:
             raise InputError(f"cannot read CSV ({str(exc).splitlines()[0]})", str(path)) from None
-        _require(names, header, path)
+        _require(names, header, path, time_column)
         wanted = names or header
         opts = pcsv.ConvertOptions(include_columns=wanted, column_types={n: pa.float64() for n in wanted})
         try:
@@ -177,16 +180,17 @@ def _whitespace_columns(p: Path, names: list[str] | None) -> tuple[list[str], np
     return [available[i] for i in idx], data[:, idx]
 
 
-def _require(names: list[str] | None, available: list[str], path) -> None:
+def _require(names: list[str] | None, available: list[str], path, time_column: str | None = None) -> None:
+    """Every name in ``names`` must be a column; a missing time column points to the sample rate."""
     if names is None:
         return
     missing = [n for n in names if n not in available]
     if missing:
-        raise InputError(
-            f"no column {', '.join(repr(m) for m in missing)} (columns: {', '.join(available) or 'none'}); "
-            "name the columns with {columns}",
-            str(path),
-        )
+        advice = "name the columns with {columns}"
+        if missing == [time_column]:
+            advice = "give {rate_hz} for a log without time, or " + advice
+        raise InputError(f"no column {', '.join(repr(m) for m in missing)} (columns: {', '.join(available) or 'none'}); "
+                         + advice, str(path))
 
 
 def read_log(
@@ -230,7 +234,7 @@ def read_log(
             )
         data = arr
     else:
-        _, data = read_columns(p, wanted)
+        _, data = read_columns(p, wanted, time_column if use_time else None)
     if use_time:
         t, values = data[:, 0], data[:, 1:]
     else:
@@ -317,7 +321,7 @@ def read_static(log: str | Path, names: list[str], rate_hz: float | None):
                              str(log))
         return source, float(rate_hz)
     wanted = names if rate_hz is not None else ["time"] + names
-    _, data = read_columns(log, wanted)
+    _, data = read_columns(log, wanted, None if rate_hz is not None else "time")
     if rate_hz is not None:
         return data, float(rate_hz)
     t = data[:, 0]
