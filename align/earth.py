@@ -14,12 +14,23 @@ EARTH_RATE = 7.2921150e-5
 
 
 def vertical_rate(latitude: float) -> float:
-    """Vertical (up) component of Earth rate, rad/s: ``Omega sin(latitude)``."""
+    """Vertical (up) component of Earth rate: ``Omega sin(latitude)`` (reference section 4, last item).
+
+    Parameters
+    ----------
+    latitude : float
+        Geodetic latitude, rad (north positive).
+
+    Returns
+    -------
+    float
+        rad/s; 7.29e-5 rad/s (15.041 deg/h) at the pole.
+    """
     return EARTH_RATE * np.sin(latitude)
 
 
 def earth_rate_in_frame(latitude: float, up: np.ndarray, heading: np.ndarray) -> np.ndarray:
-    """Earth rate in a frame whose ``up`` axis is vertical, turned by ``heading``.
+    """Earth rate in a frame whose ``up`` axis is vertical, turned by ``heading`` (reference section 4).
 
     Parameters
     ----------

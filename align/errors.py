@@ -6,14 +6,17 @@ its own terms (``gyro_units``, ``rate_hz``); the command line alone turns such
 a name into its flag, the error into one line on stderr and an exit status.
 The library never prints and never exits.
 
-Messages and ``where`` may name an input as a placeholder: ``{gyro_units}``
-(the input) or ``{gyro_units=deg/s}`` (the input set to a value). ``str(error)``
-renders them in Python terms (``gyro_units``, ``gyro_units='deg/s'``);
-:meth:`AlignError.render` takes the caller's own spelling (the CLI's flags).
+A message may name an input as a placeholder: ``{gyro_units}`` (the input) or
+``{gyro_units=deg/s}`` (the input set to a value); ``where`` may be one
+placeholder alone (``"{gyro_units}"``), otherwise it is taken as it is (a file
+name may hold braces). ``str(error)`` renders placeholders in Python terms
+(``gyro_units``, ``gyro_units='deg/s'``); :meth:`AlignError.render` takes the
+caller's own spelling (the CLI's flags). User text put into a message goes
+through :func:`literal`, so that its braces are never read as placeholders.
 
 Public names
 ------------
-AlignError, InputError, UnitError, TestError, HandednessError, CheckFailed, field_names
+AlignError, InputError, UnitError, TestError, HandednessError, CheckFailed, field_names, literal
 """
 
 from __future__ import annotations
@@ -29,9 +32,21 @@ def _python_spelling(name: str, value: str | None) -> str:
     return name if value is None else f"{name}={value!r}"
 
 
+def literal(text: object) -> str:
+    """``text`` for a message, its braces doubled so that no placeholder is read in it."""
+    return str(text).replace("{", "{{").replace("}", "}}")
+
+
+def _sub(text: str, spell: Callable[[str, str | None], str]) -> str:
+    """Placeholders replaced by ``spell(name, value)``; doubled braces become single ones."""
+    parts = re.split(r"(\{\{|\}\})", text)
+    return "".join("{" if p == "{{" else "}" if p == "}}" else
+                   _PLACEHOLDER.sub(lambda m: spell(m.group(1), m.group(2)), p) for p in parts)
+
+
 def field_names(text: str) -> list[str]:
     """The input names used as placeholders in ``text`` (in order)."""
-    return [m.group(1) for m in _PLACEHOLDER.finditer(text)]
+    return [m.group(1) for p in re.split(r"\{\{|\}\}", text) for m in _PLACEHOLDER.finditer(p)]
 
 
 class AlignError(Exception):
@@ -54,18 +69,21 @@ class AlignError(Exception):
         self.message = message
         super().__init__(self.render())
 
+    def _where_is_field(self) -> bool:
+        return bool(self.where) and _PLACEHOLDER.fullmatch(self.where) is not None
+
     @property
     def fields(self) -> list[str]:
-        """Inputs named by the error (placeholders in ``where`` and the message)."""
-        return field_names(f"{self.where or ''} {self.message}")
+        """Inputs named by the error (a placeholder ``where`` and the message's placeholders)."""
+        return (field_names(self.where) if self._where_is_field() else []) + field_names(self.message)
 
     def render(self, spell: Callable[[str, str | None], str] = _python_spelling) -> str:
         """The error as one line, inputs spelled by ``spell(name, value_or_None)``."""
-
-        def sub(text: str) -> str:
-            return _PLACEHOLDER.sub(lambda m: spell(m.group(1), m.group(2)), text)
-
-        return f"{sub(self.where)}: {sub(self.message)}" if self.where else sub(self.message)
+        text = _sub(self.message, spell)
+        if not self.where:
+            return text
+        where = _sub(self.where, spell) if self._where_is_field() else self.where
+        return f"{where}: {text}"
 
 
 class InputError(AlignError):

@@ -20,7 +20,17 @@ from align.units import parse_quantity
 
 @dataclass(frozen=True)
 class Figure:
-    """One datasheet figure: a quantity string, where it comes from, and whether it is confirmed."""
+    """One datasheet figure: a quantity string, where it comes from, and whether it is confirmed.
+
+    Attributes
+    ----------
+    value : str
+        The quantity with its unit, e.g. ``"1 deg"`` or ``"0.3 deg/sqrt(h)"``.
+    source : str
+        Where the figure comes from.
+    confirmed : bool
+        True when read from the part's datasheet itself.
+    """
 
     value: str
     source: str
@@ -29,7 +39,29 @@ class Figure:
 
 @dataclass(frozen=True)
 class Part:
-    """A datasheet preset. Figures absent from a datasheet are None."""
+    """A datasheet preset. Figures absent from a datasheet are None.
+
+    Attributes
+    ----------
+    name : str
+        Part number, e.g. ``"ADIS16485"``.
+    kind : str
+        ``"module"`` (a packaged IMU with mounting holes) or ``"chip"``.
+    package_x, package_y : Figure or None
+        Package length ``L`` and width ``W`` (Eq 2-3, Example 1), a length.
+    hole_spacing_x, hole_spacing_y : Figure or None
+        Distances between mounting holes along x and y (``R_S`` of Eq 4), a length.
+    axis_to_package : Figure or None
+        Axis-to-package (axis-to-frame) misalignment, ``theta_IMU`` of Eq 1, an angle.
+    axis_to_axis : Figure or None
+        Axis-to-axis misalignment (Eq 32-34), an angle.
+    arw : Figure or None
+        Angle random walk ``N`` (reference section 6), e.g. ``"0.3 deg/sqrt(h)"``.
+    bias_instability : Figure or None
+        Bias instability ``B`` (reference section 6), an angular rate.
+    noise_density : Figure or None
+        Rate noise density, e.g. ``"0.008 deg/s/sqrt(Hz)"`` (numerically ``N`` in deg/sqrt(s)).
+    """
 
     name: str
     kind: str
@@ -44,11 +76,33 @@ class Part:
     noise_density: Figure | None = None
 
     def si(self, name: str, expect: str) -> float | None:
-        """A figure in SI units, or None when the part has no such figure."""
+        """A figure in SI units, or None when the part has no such figure.
+
+        Parameters
+        ----------
+        name : str
+            The figure's attribute, e.g. ``"axis_to_package"`` or ``"arw"``.
+        expect : str
+            Its dimension, a key of :data:`align.units.DIMENSIONS` (``"angle"``,
+            ``"length"``, ``"angle_random_walk"``, ...).
+
+        Returns
+        -------
+        float or None
+            The value in SI units (m, rad, rad/sqrt(s), rad/s).
+        """
         fig = getattr(self, name)
         return None if fig is None else parse_quantity(fig.value, expect, f"part {self.name}.{name}")
 
     def to_dict(self) -> dict:
+        """The preset as plain data, for a result's ``inputs`` or a report.
+
+        Returns
+        -------
+        dict
+            ``name``, ``kind`` and, for each figure the part has, ``{"value", "source",
+            "confirmed"}`` (the value keeps its unit string).
+        """
         out = {"name": self.name, "kind": self.kind}
         for key in ("package_x", "package_y", "hole_spacing_x", "hole_spacing_y", "axis_to_package",
                     "axis_to_axis", "arw", "bias_instability", "noise_density"):
@@ -113,7 +167,24 @@ PARTS: dict[str, Part] = {p.name: p for p in (
 
 
 def get_part(name: str, where: str = "imu.part") -> Part:
-    """Look up a preset by name (case-insensitive); an unknown name lists the known ones."""
+    """Look up a preset by name (case-insensitive); an unknown name lists the known ones.
+
+    Parameters
+    ----------
+    name : str
+        Part number, e.g. ``"adis16485"``.
+    where : str
+        The file field or input the name came from, for the error message.
+
+    Returns
+    -------
+    Part
+
+    Raises
+    ------
+    InputError
+        For a name that is not in :data:`PARTS`.
+    """
     for key, part in PARTS.items():
         if key.lower() == str(name).strip().lower():
             return part

@@ -32,6 +32,7 @@ import numpy as np
 from align import __version__
 from align.errors import InputError
 from align.io.files import read_json, write_json
+from align.plausible import check_usable_model
 from align.units import parse_unit
 from align.values import Value
 
@@ -44,7 +45,7 @@ KNOWN: dict[str, str] = {
     "imu-align.allan": "align.noise.job",
     "imu-align.plan": "align.noise.planner",
     "imu-align.allowable": "align.sensitivity.allowable",
-    "imu-align.check": "align.sensitivity.allowable",
+    "imu-align.check": "align.sensitivity.margins",
     "imu-align.budget": "mechanics.budget",
 }
 
@@ -137,13 +138,25 @@ class Result(Value):
                              f"(up to {cls.VERSION}); upgrade imu-align", where)
 
     def correction(self, sensor: str | None = None, where: str = "result") -> Correction:
-        """What corrects a log of ``sensor`` (the only sensor when None); results that correct nothing refuse."""
+        """What corrects a log of ``sensor`` (the only sensor when None); results that correct nothing refuse.
+
+        A result that corrects a log checks its matrix first (finite, invertible, ``det > 0``:
+        :func:`align.plausible.check_usable_model`), naming ``where`` (the file).
+        """
         raise InputError(f"holds an {self.FORMAT} result, which corrects no log; give an alignment or a calibration", where)
 
-    def _only_sensor(self, held: str, sensor: str | None, where: str) -> Correction:
-        """``self`` when ``sensor`` is None or ``held`` (for results of one sensor)."""
+    def _only_sensor(self, held: str, sensor: str | None, where: str, matrix: str = "M") -> Correction:
+        """``self`` when ``sensor`` is None or ``held`` (for results of one sensor), its ``matrix`` checked usable.
+
+        Raises
+        ------
+        InputError, TestError, HandednessError
+            Another sensor asked for; the matrix not finite, singular or ``det <= 0``
+            (:func:`align.plausible.check_usable_model`): no log is corrected with it.
+        """
         if sensor is not None and sensor != held:
             raise InputError(f"holds a {held} result, no {sensor} calibration; choose another {{sensor}}", where)
+        check_usable_model(getattr(self, matrix), where, matrix)
         return self  # type: ignore[return-value]
 
     def to_dict(self) -> dict[str, Any]:  # pragma: no cover - every subclass implements it
@@ -151,6 +164,20 @@ class Result(Value):
 
     @classmethod
     def from_dict(cls, d: dict[str, Any], where: str = "result") -> Result:  # pragma: no cover
+        """The result a file's dictionary holds.
+
+        Parameters
+        ----------
+        d : dict
+            A result file's JSON object.
+        where : str
+            The file's name, for messages.
+
+        Raises
+        ------
+        InputError
+            Another format, a newer version, or a malformed body.
+        """
         raise NotImplementedError
 
 

@@ -18,8 +18,12 @@ import re
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
-from align.errors import UnitError
+from align.errors import UnitError, literal
+
+if TYPE_CHECKING:  # numpy only for the hints: the command line's --help imports no numerical library
+    import numpy as np
 
 #: one degree in radians
 DEG = math.pi / 180.0
@@ -41,7 +45,19 @@ _BASES = ("m", "s", "rad", "T", "count")
 
 @dataclass(frozen=True)
 class Unit:
-    """A unit: a factor to SI and a dimension (exponents of m, s, rad, T, count)."""
+    """A unit: a factor to SI and a dimension (exponents of m, s, rad, T, count).
+
+    Units multiply, divide and take rational powers (``deg/sqrt(h)``); angle is
+    a dimension of its own (reference section 1: radians inside, degrees at the
+    edges).
+
+    Attributes
+    ----------
+    factor : float
+        One of this unit in SI (angles in rad), e.g. ``pi / 180`` for ``deg/s``.
+    dim : tuple of Fraction, length 5
+        Exponents of m, s, rad, T and count.
+    """
 
     factor: float
     dim: tuple[Fraction, ...]
@@ -181,11 +197,11 @@ def parse_unit(text: str, expect: str | None = None, where: str | None = None) -
         if parser.peek() is not None:
             raise ValueError(f"unexpected '{parser.peek()}'")
     except (ValueError, ZeroDivisionError, IndexError) as exc:
-        raise UnitError(f"cannot read unit '{text}' ({exc})", where) from None
+        raise UnitError(f"cannot read unit '{literal(text)}' ({literal(exc)})", where) from None
     if expect is not None:
         want, example = DIMENSIONS[expect]
         if unit.dim != want.dim:
-            raise UnitError(f"'{text}' is not {example}", where)
+            raise UnitError(f"'{literal(text)}' is not {example}", where)
     return unit
 
 
@@ -197,9 +213,9 @@ def parse_quantity(text: str | float | int, expect: str, where: str | None = Non
 
     Parameters
     ----------
-    text : str
+    text : str, float or int
         For example ``"100 deg/s"``, ``"-360 deg"``, ``"0.3 deg/sqrt(h)"``.
-        A bare number is accepted only for ``expect="dimensionless"``.
+        A bare number (string or not) is accepted only for ``expect="dimensionless"``.
     expect : str
         A key of :data:`DIMENSIONS`.
     where : str, optional
@@ -211,19 +227,21 @@ def parse_quantity(text: str | float | int, expect: str, where: str | None = Non
         The value in SI units (radians for angles).
     """
     if isinstance(text, bool) or not isinstance(text, (str, int, float)):
-        raise UnitError(f"expected a quantity string such as {DIMENSIONS[expect][1]!s}, got {text!r}", where)
+        raise UnitError(f"expected a quantity string such as {DIMENSIONS[expect][1]!s}, got {literal(repr(text))}", where)
     if not isinstance(text, str):
-        if expect == "dimensionless":
-            return float(text)
-        raise UnitError(f"{text!r} has no unit; write {DIMENSIONS[expect][1]}", where)
+        if expect != "dimensionless":
+            raise UnitError(f"{literal(repr(text))} has no unit; write {DIMENSIONS[expect][1]}", where)
+        if not math.isfinite(text):
+            raise UnitError(f"{literal(repr(text))} is not a finite number", where)
+        return float(text)
     m = _NUMBER.match(text)
     if not m:
-        raise UnitError(f"'{text}' does not start with a number; write {DIMENSIONS[expect][1]}", where)
+        raise UnitError(f"'{literal(text)}' does not start with a number; write {DIMENSIONS[expect][1]}", where)
     value, unit_text = float(m.group(1)), m.group(2).strip()
     if not unit_text and expect != "dimensionless":
-        raise UnitError(f"'{text}' has no unit; write {DIMENSIONS[expect][1]}", where)
+        raise UnitError(f"'{literal(text)}' has no unit; write {DIMENSIONS[expect][1]}", where)
     if not math.isfinite(value):
-        raise UnitError(f"'{text}' is not a finite number", where)
+        raise UnitError(f"'{literal(text)}' is not a finite number", where)
     return value * parse_unit(unit_text, expect, where).factor
 
 
@@ -255,17 +273,46 @@ def parse_scale(text: str, expect: str, where: str | None = None) -> tuple[float
         return parse_quantity(text, expect, where), SHOWN_IN[expect]
     unit = parse_unit(text, where=where)
     if unit.dim not in (DIMENSIONS[expect][0].dim, DIMENSIONS["counts"][0].dim):
-        raise UnitError(f"'{text}' is not {DIMENSIONS[expect][1]}, 'counts' or the size of one count", where)
+        raise UnitError(f"'{literal(text)}' is not {DIMENSIONS[expect][1]}, 'counts' or the size of one count", where)
     return unit.factor, text
 
 
-def to_unit(value_si, unit: str):
-    """Convert an SI value (scalar or array) to ``unit`` (inverse of parsing)."""
+def to_unit(value_si: float | np.ndarray, unit: str) -> float | np.ndarray:
+    """Convert an SI value to ``unit`` (the inverse of :func:`parse_quantity`).
+
+    Parameters
+    ----------
+    value_si : float or ndarray, any shape
+        Value in SI units (rad, rad/s, m, s, m/s^2, T, ...).
+    unit : str
+        Target unit, e.g. ``"deg/s"`` or ``"deg/h"``; any unit :func:`parse_unit` reads.
+
+    Returns
+    -------
+    float or ndarray, same shape as ``value_si``
+        ``value_si`` divided by the unit's factor to SI. The dimension is not
+        checked.
+    """
     return value_si / parse_unit(unit).factor
 
 
 def format_quantity(value_si: float, unit: str, digits: int = 6) -> str:
-    """Format an SI value as ``"<number> <unit>"``, the form the parser reads back."""
+    """Format an SI value as ``"<number> <unit>"``, the form the parser reads back.
+
+    Parameters
+    ----------
+    value_si : float
+        Value in SI units (rad, rad/s, m, ...).
+    unit : str
+        Unit to show it in, e.g. ``"deg/s"``.
+    digits : int
+        Significant digits (``%g`` formatting).
+
+    Returns
+    -------
+    str
+        For example ``"100 deg/s"``.
+    """
     return f"{to_unit(value_si, unit):.{digits}g} {unit}"
 
 
@@ -276,7 +323,22 @@ _MIXUPS = ((180 / math.pi, "the log looks like deg/s read as rad/s: set {gyro_un
 
 
 def unit_mixup_hint(ratio: float) -> str | None:
-    """A message when measured/planned rates differ by a unit factor (57.3, 1/57.3, 1000, 1/1000)."""
+    """A message when measured and planned rates differ by a unit factor.
+
+    The factors are 180/pi (deg/s read as rad/s), pi/180, 1000 (mdps read as
+    deg/s) and 1/1000, each within 10 %.
+
+    Parameters
+    ----------
+    ratio : float
+        Measured rate (or angle) over the planned one, dimensionless.
+
+    Returns
+    -------
+    str or None
+        The message, naming the likely mix-up and the fix as a ``{gyro_units=...}``
+        placeholder; None when the ratio is near no unit factor.
+    """
     for factor, hint in _MIXUPS:
         if abs(ratio / factor - 1) < 0.1:
             return f"measured rates are {ratio:.4g}x the plan's: {hint}"

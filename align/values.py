@@ -16,13 +16,29 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import Any
+from typing import Any, Self
 
 import numpy as np
+import numpy.typing as npt
 
 
-def frozen_array(a, shape: tuple[int, ...] | None = None, dtype=float) -> np.ndarray:
-    """A read-only copy of ``a`` as an ndarray (reshaped when ``shape`` is given)."""
+def frozen_array(a: npt.ArrayLike, shape: tuple[int, ...] | None = None, dtype: npt.DTypeLike = float) -> np.ndarray:
+    """A read-only copy of ``a`` as an ndarray (reshaped when ``shape`` is given).
+
+    Parameters
+    ----------
+    a : array_like, any shape
+        The values, in whatever unit the caller keeps them.
+    shape : tuple of int, optional
+        Shape to give the copy, e.g. ``(3, 3)``.
+    dtype : data-type
+        dtype of the copy (float by default).
+
+    Returns
+    -------
+    ndarray, shape ``shape`` or that of ``a``
+        A new array with ``flags.writeable`` False; ``a`` itself is not changed.
+    """
     arr = np.array(a, dtype=dtype)
     if shape is not None:
         arr = arr.reshape(shape)
@@ -63,6 +79,21 @@ def approx_equal(a: Any, b: Any, rtol: float = 1e-9, atol: float = 0.0) -> bool:
 
     Floats and arrays agree when ``|a - b| <= atol + rtol |b|`` element-wise
     (NaN agrees with NaN); everything else must be equal.
+
+    Parameters
+    ----------
+    a, b : Any
+        Values to compare: dataclasses field by field (same type), arrays of the
+        same shape, dicts with the same keys, lists and tuples of the same length,
+        numbers, and anything else with ``==``.
+    rtol : float
+        Relative tolerance, dimensionless (relative to ``b``).
+    atol : float
+        Absolute tolerance, in the values' own (SI) units.
+
+    Returns
+    -------
+    bool
     """
     return _same(a, b, rtol, atol)
 
@@ -71,7 +102,9 @@ class Value:
     """Mixin for frozen dataclasses: read-only array fields and value equality.
 
     Declare subclasses with ``@dataclass(frozen=True, eq=False)``; a subclass
-    with its own ``__post_init__`` calls ``super().__post_init__()``.
+    with its own ``__post_init__`` calls ``super().__post_init__()``. Array
+    fields are copied read-only; ``==`` compares every field by value (arrays
+    element-wise, NaN equal to NaN).
     """
 
     def __post_init__(self) -> None:
@@ -85,6 +118,18 @@ class Value:
 
     __hash__ = None  # values holding arrays are not hashable
 
-    def replace(self, **changes):
-        """A copy with some fields changed (``dataclasses.replace``)."""
+    def replace(self, **changes: Any) -> Self:
+        """A copy with some fields changed (``dataclasses.replace``).
+
+        Parameters
+        ----------
+        **changes : Any
+            Field name -> new value, in the field's own unit (SI inside the program).
+
+        Returns
+        -------
+        Self
+            A new value of the same type (``__post_init__`` runs again: new
+            arrays are copied read-only); the original is unchanged.
+        """
         return dataclasses.replace(self, **changes)

@@ -23,8 +23,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from align.io.files import read_toml  # noqa: E402
-from mechanics.budget import monte_carlo  # noqa: E402
+from align.io import read_toml  # noqa: E402
+from mechanics.montecarlo import monte_carlo  # noqa: E402
 from mechanics.mount import mount_from_dict  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))

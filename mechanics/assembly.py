@@ -23,7 +23,7 @@ from mechanics.rest import corner_geometry, rest_plane_hull, rest_planes
 
 
 def rotate_axes(a: np.ndarray, b: np.ndarray, skew: np.ndarray, axes: np.ndarray) -> np.ndarray:
-    """Rotate package-frame gyro axes into the system frame and return their misalignment.
+    """Rotate package-frame gyro axes into the system frame and return their misalignment (section 2).
 
     The package is turned by ``skew`` about z, then tilted by the rotation that
     takes ``e_z`` to the rest-plane normal ``n ~ (-a, -b, 1)`` (Rodrigues, axis
@@ -32,9 +32,9 @@ def rotate_axes(a: np.ndarray, b: np.ndarray, skew: np.ndarray, axes: np.ndarray
     Parameters
     ----------
     a, b : ndarray, shape (N,)
-        Rest-plane slopes.
+        Rest-plane slopes along x and y (``z = a x + b y + c``), dimensionless.
     skew : ndarray, shape (N,)
-        rad.
+        Rotation about z (Eq 4), rad.
     axes : ndarray, shape (N, 3, 3)
         Row ``i``: gyro ``i``'s axis in the package frame (normalised here).
 
@@ -64,13 +64,43 @@ def rotate_axes(a: np.ndarray, b: np.ndarray, skew: np.ndarray, axes: np.ndarray
 
 
 def skew_limit(m: Mount) -> float:
-    """Largest skew about z with each screw at the edge of its clearance and position tolerance."""
+    """Largest skew about z with each screw at the edge of its clearance and position tolerance (Eq 4).
+
+    ``asin((c + t / 2) / R_S)``: the radial clearance ``c = (D_H - D_M) / 2``
+    widened by the radius of the screw's position tolerance zone (diameter
+    ``t``), capped at 90 deg.
+
+    Parameters
+    ----------
+    m : Mount
+        The mounting: ``spacing_x``, ``spacing_y`` (for ``R_S``), the screw and
+        hole diameters and ``position_tolerance``, m.
+
+    Returns
+    -------
+    float
+        rad.
+    """
     r = screw_radius(m.spacing_x, m.spacing_y)
     return float(np.arcsin(min(1.0, (m.clearance + m.position_tolerance / 2) / r)))
 
 
 def rest_slopes(m: Mount, heights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rest-plane slopes: closed form for four corner ledges, the trimesh hull otherwise."""
+    """Rest-plane slopes: closed form for four corner ledges, the trimesh hull otherwise (Eq 2-3).
+
+    Parameters
+    ----------
+    m : Mount
+        The mounting; ``m.pads`` (P, V, 2), m, gives the ledge layout.
+    heights : ndarray, shape (N, P)
+        Ledge-top heights of ``N`` configurations, m (in :data:`~mechanics.rest.CORNERS`
+        order for four corner ledges).
+
+    Returns
+    -------
+    a, b : ndarray, shape (N,)
+        Slopes of each resting plane along x and y, dimensionless.
+    """
     try:
         geo = corner_geometry(m.pads)
     except InputError:
@@ -85,12 +115,19 @@ def worst_case_per_axis(m: Mount) -> np.ndarray:
 
     The corners of the ledge-height box go through the rest model, with the
     skew at either limit (:func:`skew_limit`); the largest angle of each gyro
-    axis is added to its datasheet term and the extras.
+    axis is added to its datasheet term and the extras (the worst case of Eq 1:
+    the plain sum).
+
+    Parameters
+    ----------
+    m : Mount
+        The mounting: ledges, heights and their tolerance (m), screws (m), the
+        datasheet axis-to-package term (3,) and extra terms (rad).
 
     Returns
     -------
     ndarray, shape (3,)
-        rad.
+        Worst-case misalignment of each gyro axis, rad.
     """
     skew_w = skew_limit(m)
     corners = np.array(list(product((0.0, m.height_tolerance), repeat=len(m.pads)))) + m.pad_heights[None, :]

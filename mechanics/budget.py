@@ -27,7 +27,9 @@ import numpy as np
 
 from align import CONVENTION
 from align.errors import InputError
-from align.results import Result
+from align.io.keys import check_keys
+from align.plausible import malformed
+from align.results import Result, envelope
 from align.units import DEG
 from mechanics.assembly import skew_limit, worst_case_per_axis
 from mechanics.formulas import rss, screw_radius, skew_from_screws, tilt_from_ledges
@@ -46,6 +48,11 @@ def _xyz_deg(values: np.ndarray) -> dict:
 
 def _xyz_rad(d: dict) -> np.ndarray:
     return np.array([d[a] for a in "xyz"], dtype=float) * DEG
+
+
+#: the keys of a budget file after its envelope
+FILE_KEYS = ("tilt_x_deg", "tilt_y_deg", "skew_z_deg", "imu_deg", "mounting_deg", "total_deg", "sum_deg", "per_axis_deg",
+             "worst_case_deg", "worst_case_per_axis_deg", "skew_worst_deg", "method", "mount", "monte_carlo", "inputs")
 
 
 class Budget(Result, format=FORMAT, convention=BUDGET_CONVENTION):
@@ -145,8 +152,9 @@ class Budget(Result, format=FORMAT, convention=BUDGET_CONVENTION):
 
     @classmethod
     def from_dict(cls, d: dict, where: str = "result") -> Budget:
-        """Read the form written by :meth:`to_dict`."""
+        """Read the form written by :meth:`to_dict`; a key it does not know is refused (a misspelling)."""
         cls.check_envelope(d, where)
+        check_keys(d, [*envelope(cls.FORMAT, cls.VERSION, cls.CONVENTION), *FILE_KEYS], where)
         try:
             mc = d.get("monte_carlo")
             return cls(
@@ -157,7 +165,8 @@ class Budget(Result, format=FORMAT, convention=BUDGET_CONVENTION):
                 None if mc is None else MonteCarlo.from_dict(mc), dict(d.get("inputs", {})),
             )
         except (KeyError, TypeError, ValueError, AttributeError) as exc:
-            raise InputError(f"malformed budget result ({exc!r}); regenerate it with imu-align budget", where) from None
+            raise InputError(f"malformed budget result ({malformed(exc)}); regenerate it with imu-align budget",
+                             where) from None
 
 
 def budget(m: Mount) -> Budget:

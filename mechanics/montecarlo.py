@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from align.errors import InputError
 from align.units import DEG
 from align.values import Value, frozen_array
 from mechanics.assembly import rotate_axes, skew_limit, worst_case_per_axis
@@ -125,7 +126,12 @@ def sample_skew(m: Mount, n: int, rng: np.random.Generator) -> np.ndarray:
     screws = m.screws
     limit = skew_limit(m)
     out = np.empty(0)
+    tries = 0
     while len(out) < n:
+        tries += 1
+        if tries > 200 and len(out) == 0:
+            raise InputError("no drawn screw position fits its hole (clearance against position tolerance); check "
+                             "the mount's screws and holes", "mount: [screws]")
         k = max(2 * (n - len(out)), 1024)
         theta = rng.uniform(-limit, limit, k)
         t = _disc(rng, k, c + r_tol, "uniform")  # every fitting shift lies in this disc (symmetric pattern)
@@ -191,20 +197,27 @@ def monte_carlo(m: Mount, n: int, seed: int = 0, chunk: int = 50_000, bins: int 
     import os
     from concurrent.futures import ThreadPoolExecutor
 
-    if n < 1:
-        raise ValueError("n must be positive")
+    if int(n) < 1:
+        raise InputError(f"needs at least one draw (got {int(n)})", "{monte_carlo}")
+    if int(seed) < 0:
+        raise InputError(f"a seed is a whole number >= 0 (got {int(seed)})", "{seed}")
     geo = corner_geometry(m.pads)
     sizes = [min(chunk, n - i) for i in range(0, n, chunk)]
     streams = [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(len(sizes))]
     workers = workers or min(4, os.cpu_count() or 1)
     done = 0
     results = []
-    with ThreadPoolExecutor(workers) as pool:
+    pool = ThreadPoolExecutor(workers)
+    try:
         for ang, tsq in pool.map(lambda job: _draw(m, geo, job[0], job[1], include), zip(sizes, streams)):
             results.append((ang, tsq))
             done += len(ang)
             if progress is not None:
                 progress(done)
+    except BaseException:  # Ctrl-C or an error: drop the batches not started instead of waiting for them all
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    pool.shutdown()
     ang = np.concatenate([r[0] for r in results])
     top = max(float(worst_case_per_axis(m).max()) * 1.05, float(ang.max()) * 1.0001) + 1e-12
     edges = np.linspace(0.0, top, bins + 1)

@@ -6,7 +6,7 @@ package centre, x along ``size_x``, y along ``size_y``, z up.
 
 Public names
 ------------
-Mount, mount_from_dict, corner_ledges, DISTRIBUTIONS
+Mount, mount_from_dict, mount_inputs, corner_ledges, DISTRIBUTIONS, MOUNT_KEYS
 """
 
 from __future__ import annotations
@@ -16,7 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from align.errors import InputError
+from align.errors import InputError, literal
+from align.io.keys import check_keys, file_name, referenced_file, table
 from align.parts import get_part
 from align.units import DEG, parse_quantity
 from align.values import Value
@@ -121,7 +122,7 @@ class Mount(Value):
                        {k: float(v) * DEG for k, v in d.get("extras_deg", {}).items()},
                        dict(d["distributions"]), d.get("part"), d.get("baseplate"))
         except (KeyError, TypeError, ValueError, IndexError) as exc:
-            raise InputError(f"malformed mount ({exc!r})", where) from None
+            raise InputError(f"malformed mount ({literal(repr(exc))})", where) from None
 
 
 def corner_ledges(size_x: float, size_y: float, size: float) -> np.ndarray:
@@ -138,65 +139,133 @@ def corner_ledges(size_x: float, size_y: float, size: float) -> np.ndarray:
     return centres[:, None, :] + square[None, :, :]
 
 
-def _table(data: dict, name: str, where: str, required: bool = True) -> dict:
-    t = data.get(name)
-    if t is None:
-        if required:
-            raise InputError(f"missing table [{name}]", where)
-        return {}
-    if not isinstance(t, dict):
-        raise InputError(f"[{name}] must be a table", where)
-    return t
+#: the longest length a mount file may give, m: beyond, the number or its unit is wrong
+MAX_LENGTH_M = 1.0
 
 
 def _length(t: dict, key: str, section: str, where: str, default: str | None = None, positive: bool = True) -> float:
+    """A length of ``[section]``: finite, at most :data:`MAX_LENGTH_M`; positive (a dimension) or, when not
+    ``positive``, zero or more (a tolerance)."""
     if key not in t:
         if default is None:
             raise InputError(f"missing field (e.g. {key} = \"2 mm\")", f"{where}: {section}.{key}")
         value = parse_quantity(default, "length")
     else:
         value = parse_quantity(t[key], "length", f"{where}: {section}.{key}")
-    if value < 0 or (positive and value == 0):
-        raise InputError(f"must be {'positive' if positive else 'zero or more'}, got {t.get(key)!r}", f"{where}: {section}.{key}")
+    if not np.isfinite(value) or value < 0 or (positive and value == 0):
+        raise InputError(f"must be {'positive' if positive else 'zero or more'}, got {literal(repr(t.get(key)))}",
+                         f"{where}: {section}.{key}")
+    if value > MAX_LENGTH_M:
+        raise InputError(f"{value * 1e3:.4g} mm is not a dimension of an IMU mount (at most {MAX_LENGTH_M * 1e3:g} mm); "
+                         "check the number and its unit", f"{where}: {section}.{key}")
     return value
 
 
 def _distribution(t: dict, section: str, where: str) -> str:
     d = t.get("distribution", "uniform")
     if d not in DISTRIBUTIONS:
-        raise InputError(f"distribution '{d}' is not one of {', '.join(DISTRIBUTIONS)}", f"{where}: {section}.distribution")
+        raise InputError(f"distribution '{literal(d)}' is not one of {', '.join(DISTRIBUTIONS)}",
+                         f"{where}: {section}.distribution")
     return d
+
+
+def _misalignment(value: np.ndarray, here: str) -> np.ndarray:
+    """A misalignment bound (rad): finite, zero or more, under 90 deg."""
+    if np.any(value < 0):
+        raise InputError("must not be negative", here)
+    if np.any(value >= np.pi / 2):
+        raise InputError(f"{np.max(value) / DEG:g} deg is not a misalignment bound: it must be under 90 deg", here)
+    return value
 
 
 def _axis_to_package(imu: dict, where: str) -> tuple[np.ndarray, str | None]:
     part = imu.get("part")
     preset = get_part(part, f"{where}: imu.part") if part is not None else None
     raw = imu.get("axis_to_package")
+    here = f"{where}: imu.axis_to_package"
     if raw is None:
         if preset is None or preset.axis_to_package is None:
-            raise InputError("missing field (e.g. axis_to_package = \"1 deg\", or a known part)", f"{where}: imu.axis_to_package")
+            raise InputError("missing field (e.g. axis_to_package = \"1 deg\", or a known part)", here)
         value = np.full(3, preset.si("axis_to_package", "angle"))
     elif isinstance(raw, dict):
+        check_keys(raw, "xyz", here)
         missing = [a for a in "xyz" if a not in raw]
         if missing:
-            raise InputError(f"per-axis table needs x, y and z (missing {', '.join(missing)})", f"{where}: imu.axis_to_package")
-        value = np.array([parse_quantity(raw[a], "angle", f"{where}: imu.axis_to_package.{a}") for a in "xyz"])
+            raise InputError(f"per-axis table needs x, y and z (missing {', '.join(missing)})", here)
+        value = np.array([parse_quantity(raw[a], "angle", f"{here}.{a}") for a in "xyz"])
     else:
-        value = np.full(3, parse_quantity(raw, "angle", f"{where}: imu.axis_to_package"))
-    if np.any(value < 0):
-        raise InputError("must not be negative", f"{where}: imu.axis_to_package")
-    return value, (preset.name if preset else None)
+        value = np.full(3, parse_quantity(raw, "angle", here))
+    return _misalignment(value, here), (preset.name if preset else None)
+
+
+def _extras(extras_t: dict, where: str) -> dict:
+    """The ``[extra]`` terms (name -> rad); ``distribution`` is the one key that is not a term."""
+    extras = {}
+    for name, value in extras_t.items():
+        if name == "distribution":
+            continue
+        if isinstance(value, str) and value.strip() in DISTRIBUTIONS:   # a misspelled 'distribution'
+            check_keys({name: value}, ("distribution",), f"{where}: [extra]")
+        here = f"{where}: extra.{name}"
+        extras[name] = float(_misalignment(np.array([parse_quantity(value, "angle", here)]), here)[0])
+    return extras
+
+
+def _ledge_pads(ledges: dict, plate: dict, size_x: float, size_y: float, where: str, base_dir: Path | None):
+    """Ledge outlines, heights, ledge size and the STL used: square corner ledges, or from ``[baseplate]``."""
+    if not plate:
+        size = _length(ledges, "size", "ledges", where)
+        if 2 * size >= min(size_x, size_y):
+            raise InputError("ledges overlap: size must be under half the package size", f"{where}: ledges.size")
+        return corner_ledges(size_x, size_y, size), np.zeros(4), size, None
+    from mechanics.rest import ledges_from_stl
+
+    if "size" in ledges:
+        raise InputError("the [baseplate] STL gives the ledges: drop size (keep height_tolerance) or [baseplate]",
+                         f"{where}: ledges.size")
+    stl = file_name(plate, "stl", f"{where}: baseplate.stl", "plate.stl", base_dir)
+    band = _length(plate, "ledge_band", "baseplate", where, default="1 mm")
+    pads, heights = ledges_from_stl(stl, band, f"{where}: baseplate.stl")
+    return pads, heights, float(np.median([np.ptp(p[:, 0]) for p in pads])), str(stl)
+
+
+def mount_inputs(data: dict, base_dir: Path | None = None) -> list[Path]:
+    """The data files a mount file reads (its ``[baseplate]`` STL), resolved as the reader resolves them.
+
+    For output checks before any work: an output must not overwrite one of these.
+    Nothing is validated here (an unusable file is refused by :func:`mount_from_dict`).
+    """
+    return [p for p in [referenced_file(data, "baseplate", "stl", base_dir)] if p is not None]
+
+
+#: the tables of a mount file and the keys of each (``[extra]`` holds free term names and ``distribution``)
+MOUNT_KEYS = {
+    "imu": ("part", "axis_to_package", "distribution"),
+    "package": ("size_x", "size_y", "size_z"),
+    "ledges": ("size", "height_tolerance", "distribution"),
+    "baseplate": ("stl", "ledge_band"),
+    "screws": ("diameter", "hole_diameter", "spacing_x", "spacing_y", "position_tolerance"),
+    "extra": None,
+}
 
 
 def mount_from_dict(data: dict, where: str = "mount", base_dir: Path | None = None) -> Mount:
-    """Build a :class:`Mount` from parsed TOML; every problem names the field."""
-    imu = _table(data, "imu", where)
+    """Build a :class:`Mount` from parsed TOML; every problem names the field.
+
+    Unknown tables and keys are refused (:data:`MOUNT_KEYS`); dimensions must be
+    positive, tolerances zero or more, misalignment bounds under 90 deg, the hole
+    larger than the screw and the screw pattern inside the package.
+    """
+    check_keys(data, MOUNT_KEYS, where)
+    sections = {name: table(data, name, where, required=name in ("imu", "package", "screws")) for name in MOUNT_KEYS}
+    for name, known in MOUNT_KEYS.items():
+        if known is not None:
+            check_keys(sections[name], known, f"{where}: [{name}]")
+    imu, package, screws = sections["imu"], sections["package"], sections["screws"]
     axis_to_package, part = _axis_to_package(imu, where)
-    package = _table(data, "package", where)
     size_x = _length(package, "size_x", "package", where)
     size_y = _length(package, "size_y", "package", where)
     size_z = _length(package, "size_z", "package", where, default="10 mm")
-    screws = _table(data, "screws", where)
     screw_d = _length(screws, "diameter", "screws", where)
     hole_d = _length(screws, "hole_diameter", "screws", where)
     if hole_d <= screw_d:
@@ -205,41 +274,18 @@ def mount_from_dict(data: dict, where: str = "mount", base_dir: Path | None = No
     spacing_x = _length(screws, "spacing_x", "screws", where)
     spacing_y = _length(screws, "spacing_y", "screws", where)
     pos_tol = _length(screws, "position_tolerance", "screws", where, default="0 mm", positive=False)
-    if spacing_x > size_x or spacing_y > size_y:
-        raise InputError("the screw pattern is larger than the package", f"{where}: screws.spacing_x")
+    for axis, spacing, size in (("x", spacing_x, size_x), ("y", spacing_y, size_y)):
+        if spacing > size:
+            raise InputError(f"the screw pattern ({spacing * 1e3:g} mm) is larger than the package "
+                             f"({size * 1e3:g} mm)", f"{where}: screws.spacing_{axis}")
 
-    ledges = _table(data, "ledges", where, required=False)
-    plate = _table(data, "baseplate", where, required=False)
+    ledges, plate = sections["ledges"], sections["baseplate"]
     if not ledges and not plate:
         raise InputError("give [ledges] (size, height_tolerance) or [baseplate] stl = \"FILE.stl\"", where)
     tol = _length(ledges, "height_tolerance", "ledges", where, default="0 mm", positive=False)
-    baseplate = None
-    if plate:
-        from mechanics.rest import ledges_from_stl
-
-        if "stl" not in plate:
-            raise InputError("missing field stl = \"FILE.stl\"", f"{where}: baseplate.stl")
-        stl = Path(plate["stl"])
-        if base_dir is not None and not stl.is_absolute():
-            stl = base_dir / stl
-        band = _length(plate, "ledge_band", "baseplate", where, default="1 mm")
-        pads, heights = ledges_from_stl(stl, band, f"{where}: baseplate.stl")
-        size = float(np.median([np.ptp(p[:, 0]) for p in pads]))
-        baseplate = str(stl)
-    else:
-        size = _length(ledges, "size", "ledges", where)
-        if 2 * size >= min(size_x, size_y):
-            raise InputError("ledges overlap: size must be under half the package size", f"{where}: ledges.size")
-        pads, heights = corner_ledges(size_x, size_y, size), np.zeros(4)
-    extras_t = _table(data, "extra", where, required=False)
-    extras = {}
-    for name, value in extras_t.items():
-        if name == "distribution":
-            continue
-        extras[name] = parse_quantity(value, "angle", f"{where}: extra.{name}")
-        if extras[name] < 0:
-            raise InputError("must not be negative", f"{where}: extra.{name}")
+    pads, heights, size, baseplate = _ledge_pads(ledges, plate, size_x, size_y, where, base_dir)
+    extras = _extras(sections["extra"], where)
     dists = {"imu": _distribution(imu, "imu", where), "ledges": _distribution(ledges, "ledges", where),
-             "extras": _distribution(extras_t, "extra", where)}
+             "extras": _distribution(sections["extra"], "extra", where)}
     return Mount(axis_to_package, np.array([size_x, size_y, size_z]), pads, heights, size, tol, screw_d, hole_d,
                  spacing_x, spacing_y, pos_tol, extras, dists, part, baseplate)

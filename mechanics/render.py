@@ -14,6 +14,7 @@ import io
 
 import numpy as np
 
+from align.errors import InputError
 from align.units import DEG
 from mechanics.budget import Budget
 from mechanics.mount import Mount
@@ -76,6 +77,13 @@ def _box_corners(size: np.ndarray) -> np.ndarray:
 _EDGES = [(0, 1), (1, 3), (3, 2), (2, 0), (4, 5), (5, 7), (7, 6), (6, 4), (0, 4), (1, 5), (2, 6), (3, 7)]
 
 
+def _check_exaggerate(exaggerate: float) -> None:
+    """An exaggeration is a finite factor > 0 (at most 1e4: beyond it a picture shows nothing of the mount)."""
+    if not (np.isfinite(exaggerate) and 0 < exaggerate <= 1e4):
+        raise InputError(f"the angle exaggeration must be a factor > 0 and <= 10000, not {float(exaggerate):g}",
+                         "{exaggerate}")
+
+
 def _pose_matrix(a: float, b: float, c: float, skew: float, exaggerate: float) -> np.ndarray:
     """4x4 transform of the package (bottom centre at the origin) for an exaggerated pose."""
     from scipy.spatial.transform import Rotation
@@ -93,7 +101,14 @@ def _pose_matrix(a: float, b: float, c: float, skew: float, exaggerate: float) -
 
 
 def assembly_png(m: Mount, exaggerate: float = 30.0, skew: float | None = None) -> bytes:
-    """PNG: ledges, the nominal package (grey) and the resting package (red), tilt exaggerated."""
+    """PNG: ledges, the nominal package (grey) and the resting package (red), tilt exaggerated.
+
+    Raises
+    ------
+    InputError
+        ``exaggerate`` not a finite factor in (0, 1e4].
+    """
+    _check_exaggerate(exaggerate)
     import matplotlib
 
     matplotlib.use("Agg")
@@ -127,7 +142,9 @@ def assembly_png(m: Mount, exaggerate: float = 30.0, skew: float | None = None) 
 
 
 def assembly_glb(m: Mount, exaggerate: float = 30.0, skew: float = 0.0) -> bytes:
-    """GLB of the ledges and the resting package (tilt and skew exaggerated), metres."""
+    """GLB of the ledges and the resting package (tilt and skew exaggerated), metres (``exaggerate`` as in
+    :func:`assembly_png`)."""
+    _check_exaggerate(exaggerate)
     import trimesh
 
     heights = _worst_heights(m)

@@ -24,6 +24,8 @@ rest_plane_hull, rest_planes, corner_geometry, plane_tilt, ledges_from_stl, CORN
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from align.errors import InputError
@@ -34,12 +36,28 @@ _TOL = 1e-12  # m: a ledge this far above a plane still counts as touching
 def rest_plane_hull(pads: np.ndarray, heights: np.ndarray) -> tuple[float, float, float]:
     """Resting plane ``(a, b, c)`` of ``z = a x + b y + c`` from the convex hull (trimesh).
 
+    The facet of the upper convex hull of the ledge-top vertices that lies above
+    the package centre: the general form of Eq 2-3 (reference section 2).
+
     Parameters
     ----------
     pads : ndarray, shape (P, V, 2)
-        Ledge-top outlines, m.
+        Ledge-top outlines (x, y) in the package frame, centre at the origin, m.
     heights : ndarray, shape (P,)
         Ledge-top heights, m.
+
+    Returns
+    -------
+    a, b : float
+        Slopes of the plane along x and y, dimensionless (:func:`plane_tilt` turns
+        them into angles).
+    c : float
+        Height of the plane under the package centre, m.
+
+    Raises
+    ------
+    InputError
+        When the centre is not above the ledges (the package would tip over).
     """
     import trimesh
 
@@ -69,8 +87,25 @@ def _contains(tri: np.ndarray, p: np.ndarray, eps: float = 1e-12) -> bool:
 def corner_geometry(pads: np.ndarray) -> tuple[float, float, float, float]:
     """``(X, Y, hx, hy)`` of four equal axis-aligned rectangular ledges centred at ``(+/-X, +/-Y)``.
 
-    Raises :class:`InputError` for any other layout (the closed-form rest model
-    needs it; the hull model takes any layout).
+    The layout of Eq 2-3 and Example 1, which :func:`rest_planes` solves in closed form.
+
+    Parameters
+    ----------
+    pads : ndarray, shape (P, V, 2)
+        Ledge-top outlines (x, y) in the package frame, centre at the origin, m.
+
+    Returns
+    -------
+    X, Y : float
+        Distance of the ledge centres from the package centre along x and y, m.
+    hx, hy : float
+        Half-size of each ledge along x and y, m.
+
+    Raises
+    ------
+    InputError
+        For any other layout (the closed-form rest model needs it; the hull
+        model takes any layout).
     """
     lo, hi = pads.min(axis=1), pads.max(axis=1)
     rect = np.all(np.isclose(pads, lo[:, None, :], atol=1e-9) | np.isclose(pads, hi[:, None, :], atol=1e-9))
@@ -94,7 +129,7 @@ def rest_planes(
     heights: np.ndarray,
     rng: np.random.Generator | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Resting planes of a package on four corner ledges, closed form, vectorised.
+    """Resting planes of a package on four corner ledges, closed form, vectorised (Eq 2-3 generalised).
 
     With ledge tops of half-size ``hx, hy`` centred at ``(+/-X, +/-Y)`` the rest
     problem ``min_{a,b} max_vertices (h - a x - b y)`` becomes, with ``u = a X``,
@@ -117,6 +152,7 @@ def rest_planes(
     heights : ndarray, shape (N, 4)
         Ledge-top heights in :data:`CORNERS` order, m.
     rng : numpy.random.Generator, optional
+        Draws the free slope of a square layout (a tie); the midpoint without it.
 
     Returns
     -------
@@ -151,20 +187,51 @@ def rest_planes(
 
 
 def plane_tilt(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Tilt angles of a resting plane: about x ``atan(b)``, about y ``-atan(a)`` (rad).
+    """Tilt angles of a resting plane: about x ``atan(b)``, about y ``-atan(a)`` (Eq 2-3).
 
     A rotation ``alpha`` about x raises the +y side (slope ``tan alpha`` along y);
     a rotation ``beta`` about y lowers the +x side (slope ``-tan beta`` along x).
+
+    Parameters
+    ----------
+    a, b : ndarray, shape (N,)
+        Slopes of the plane ``z = a x + b y + c`` along x and y, dimensionless.
+
+    Returns
+    -------
+    alpha, beta : ndarray, shape (N,)
+        Tilt about x and about y, rad.
     """
     return np.arctan(b), -np.arctan(a)
 
 
-def ledges_from_stl(path, band: float, where: str) -> tuple[np.ndarray, np.ndarray]:
+def ledges_from_stl(path: str | Path, band: float, where: str) -> tuple[np.ndarray, np.ndarray]:
     """Ledge tops of a baseplate STL: the upward-facing facets within ``band`` of the highest.
 
-    Returns the outlines (convex hull in x-y, shape (P, V, 2), centred on the
-    centroid of the ledge centres) and heights (P,), relative to the lowest ledge, m.
     The STL is read in metres unless its extent suggests millimetres (> 1 unit).
+
+    Parameters
+    ----------
+    path : str or Path
+        The STL file.
+    band : float
+        How far below the highest upward-facing facet a facet still counts as a
+        ledge top, m.
+    where : str
+        Names the file in error messages.
+
+    Returns
+    -------
+    pads : ndarray, shape (P, V, 2)
+        Ledge-top outlines (convex hull in x-y, padded to ``V`` vertices by
+        repeating the last), centred on the centroid of the ledge centres, m.
+    heights : ndarray, shape (P,)
+        Ledge-top heights relative to the lowest ledge, m.
+
+    Raises
+    ------
+    InputError
+        An unreadable STL, no upward-facing facets, or fewer than three ledge tops.
     """
     import trimesh
     from scipy.spatial import ConvexHull

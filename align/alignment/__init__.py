@@ -5,7 +5,8 @@ Modules
 plan      the test plan (steps about system axes, rates or angles) and its TOML form
 segment   automatic segmentation of a log into dwells, turns and static periods
 estimate  estimators of ``[M | b]``: Eq 28-30 (rate pairs), Eq 31 (angle pairs), weighted
-          least squares, the two-axis shortcut (Eq 35-36)
+          least squares
+twoaxis   the two-axis shortcut (Eq 35-36): the third column inferred, with its cost
 checks    checks that turn a bad test into a clear error
 simulate  rate-table session simulator of known truth
 job       the alignment job (:func:`align`) and its result (:class:`AlignmentResult`)

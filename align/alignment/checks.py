@@ -29,23 +29,55 @@ NOT_CHECKED = "not checked"
 
 @dataclass(frozen=True, eq=False)
 class Check(Value):
-    """One check's outcome: ``status`` is ``"pass"``, ``"warn"`` or ``"not checked"`` (what it needed was not given)."""
+    """One check's outcome, shown in the alignment result.
+
+    Attributes
+    ----------
+    name : str
+        ``"durations"``, ``"saturation"``, ``"directions"``, ``"scale"`` or ``"residuals"``.
+    status : str
+        ``"pass"``, ``"warn"`` or ``"not checked"`` (:data:`NOT_CHECKED`: what it
+        needed was not given). A failed check raises instead of returning.
+    detail : str
+        One line of plain text for people (no placeholders, no flags).
+    """
 
     name: str
     status: str
     detail: str
 
     def to_dict(self) -> dict:
+        """The check as an entry of an alignment result's ``checks`` list.
+
+        Returns
+        -------
+        dict
+            ``{"name", "status", "detail"}``, all strings.
+        """
         return {"name": self.name, "status": self.status, "detail": self.detail}
 
 
 def check_span(plan: Plan, allow_two_axis: bool = False) -> int | None:
-    """The plan must turn about three independent axes (two for the shortcut).
+    """The plan must turn about three independent axes (Eq 19-27; two for the shortcut of Eq 35-36).
+
+    Parameters
+    ----------
+    plan : Plan
+        The test plan.
+    allow_two_axis : bool
+        Accept a plan that never turns about exactly one axis (the two-axis
+        shortcut then infers that column).
 
     Returns
     -------
     int or None
-        The axis never turned about, when ``allow_two_axis`` and exactly one is missing.
+        The axis never turned about (0, 1, 2), when ``allow_two_axis`` and exactly
+        one is missing; None when all three are turned about.
+
+    Raises
+    ------
+    TestError
+        When the turns do not span 3-D (and the shortcut does not apply).
     """
     turned = plan.axes_turned()
     missing = [a for a in range(3) if a not in turned]
@@ -64,7 +96,32 @@ def check_span(plan: Plan, allow_two_axis: bool = False) -> int | None:
 
 
 def check_saturation(g: np.ndarray, segments: list[Segment], gyro_range: float | None, units: str) -> Check:
-    """No sample used in a segment may reach 99 % of the stated gyro range."""
+    """No sample used in a segment may reach 99 % of the stated gyro range.
+
+    A clipped reading breaks the linear model ``g = M w + b`` (Eq 14-15) the
+    estimate rests on.
+
+    Parameters
+    ----------
+    g : ndarray, shape (n, 3)
+        Gyro readings, rad/s.
+    segments : list of Segment
+        The stretches of the log used in the fit (samples ``start`` to ``end``).
+    gyro_range : float or None
+        The gyros' full-scale range, rad/s; None skips the check.
+    units : str
+        Rate unit the message shows rates in, e.g. ``"deg/s"``.
+
+    Returns
+    -------
+    Check
+        ``"pass"``, or ``"not checked"`` without a range.
+
+    Raises
+    ------
+    TestError
+        Naming the first segment whose peak ``|g|`` reaches ``0.99 gyro_range``.
+    """
     if gyro_range is None:
         return Check("saturation", NOT_CHECKED, "no gyro range given: saturation not checked")
     limit = 0.99 * gyro_range
@@ -80,7 +137,32 @@ def check_saturation(g: np.ndarray, segments: list[Segment], gyro_range: float |
 
 
 def check_durations(segments: list[Segment], fs: float, min_duration: float, min_samples: int = 10) -> Check:
-    """Every step segment must last at least ``min_duration`` seconds and ``min_samples`` samples."""
+    """Every step segment must last at least ``min_duration`` seconds and ``min_samples`` samples.
+
+    Short dwells average too little noise away (Example 3: the averaging time
+    sets the alignment accuracy). Static periods are not checked.
+
+    Parameters
+    ----------
+    segments : list of Segment
+        The stretches of the log found for the plan's steps.
+    fs : float
+        Sample rate, Hz.
+    min_duration : float
+        Shortest allowed segment, s.
+    min_samples : int
+        Fewest allowed samples in a segment.
+
+    Returns
+    -------
+    Check
+        ``"pass"``.
+
+    Raises
+    ------
+    TestError
+        Naming the first segment that is too short (and the ``{min_dwell}`` input).
+    """
     for seg in segments:
         if seg.kind == "static":
             continue
@@ -107,6 +189,22 @@ def check_directions(measured: list[tuple[Segment, float, float]], plan: Plan, t
         Largest relative difference from the planned rate or angle.
     units : str
         Display unit of rates (angles are shown in deg).
+    where : str
+        Name of the log, for errors that concern every step.
+
+    Returns
+    -------
+    Check
+        ``"pass"`` when every step turned as planned (Eq 19-31 assume it).
+
+    Raises
+    ------
+    TestError
+        A unit mix-up (measured / planned near 57.3 or 1000), a step turned the
+        wrong way or about another axis, or a rate or angle off by more than
+        ``tolerance``.
+    HandednessError
+        When every step about one axis, in both directions, is reversed (``det(M) < 0``).
     """
     steps = [plan.steps[seg.step] for seg, _, _ in measured]
     planned = np.array([s.rate if s.rate is not None else s.angle for s in steps])
@@ -115,6 +213,18 @@ def check_directions(measured: list[tuple[Segment, float, float]], plan: Plan, t
     hint = unit_mixup_hint(float(np.median(np.abs(ratios))))
     if hint:
         raise TestError(hint, where)
+    described = []
+    for (seg, along, across), step, value in zip(measured, steps, planned):
+        unit = units if step.rate is not None else "deg"
+        said = (f"planned {format_quantity(value, unit, 5)} about {axis_name(step.axis, step.sign)}, "
+                f"measured {format_quantity(along, unit, 5)}")
+        if abs(across) > 0.5 * abs(along):  # first: a step about another axis also looks like a reversed gyro
+            raise TestError(
+                f"{said} and {format_quantity(across, unit, 5)} across that axis: the table turned about another axis; "
+                "check the fixture orientation and the step's axis",
+                seg.name,
+            )
+        described.append(said)
     for axis in range(3):
         on = np.array([s.axis == axis for s in steps])
         if len(set(np.sign(signed[on]))) == 2 and np.all(ratios[on] < 0):
@@ -124,18 +234,9 @@ def check_directions(measured: list[tuple[Segment, float, float]], plan: Plan, t
                 "the tool does not flip it",
                 where,
             )
-    for (seg, along, across), ratio, step, value in zip(measured, ratios, steps, planned):
-        unit = units if step.rate is not None else "deg"
-        said = (f"planned {format_quantity(value, unit, 5)} about {axis_name(step.axis, step.sign)}, "
-                f"measured {format_quantity(along, unit, 5)}")
+    for (seg, _, _), ratio, step, said in zip(measured, ratios, steps, described):
         if ratio < 0:
             raise TestError(f"{said}: the table turned the wrong way; re-run the step or correct its sign in the plan", seg.name)
-        if abs(across) > 0.5 * abs(along):
-            raise TestError(
-                f"{said} and {format_quantity(across, unit, 5)} across that axis: the table turned about another axis; "
-                "check the fixture orientation and the step's axis",
-                seg.name,
-            )
         if abs(ratio - 1) > tolerance:
             what = "rate" if step.rate is not None else "angle"
             raise TestError(
@@ -147,7 +248,27 @@ def check_directions(measured: list[tuple[Segment, float, float]], plan: Plan, t
 
 
 def check_scale(m: np.ndarray, tolerance: float, where: str = "result") -> Check:
-    """Scale factors ``|M[i, :]|`` must lie within ``1 +/- tolerance``."""
+    """Scale factors ``|M[i, :]|`` (reference section 1) must lie within ``1 +/- tolerance``.
+
+    Parameters
+    ----------
+    m : ndarray, shape (3, 3)
+        The estimated ``M`` (Eq 14-15), dimensionless.
+    tolerance : float
+        Largest allowed ``| |M[i, :]| - 1 |``, dimensionless (e.g. 0.2).
+    where : str
+        Names the result in the error message.
+
+    Returns
+    -------
+    Check
+        ``"pass"``, listing the three scale factors.
+
+    Raises
+    ------
+    TestError
+        For the first gyro whose scale factor is outside the band (or NaN).
+    """
     scale = np.linalg.norm(m, axis=1)
     for i, s in enumerate(scale):
         if not abs(s - 1.0) <= tolerance:
@@ -160,7 +281,30 @@ def check_scale(m: np.ndarray, tolerance: float, where: str = "result") -> Check
 
 
 def check_residuals(segments: list[Segment], rms: np.ndarray, expected: np.ndarray, units: str) -> Check:
-    """Warn (not fail) about segments whose residual is over 5x what their noise explains."""
+    """Warn (not fail) about segments whose residual is over 5x what their noise explains.
+
+    The residuals are those of the fit of ``[M | b]`` (:func:`~align.alignment.estimate.fit_lsq`,
+    Eq 28-31): a segment far off its noise hints at bias drift or a table error.
+
+    Parameters
+    ----------
+    segments : list of Segment, length k
+        The segments of the fit, in the order of ``rms`` and ``expected``.
+    rms : ndarray, shape (k,)
+        Size of each segment's residual (the alignment job passes the largest
+        ``|y - [M | b] phi|`` over the three gyros): rad/s for dwells and static
+        periods, rad for turns.
+    expected : ndarray, shape (k,)
+        The residual the segment's noise explains (1-sigma of its observation),
+        same units as ``rms``.
+    units : str
+        Rate display unit; not used by the message today.
+
+    Returns
+    -------
+    Check
+        ``"warn"`` naming the worst segment when its ratio exceeds 5, else ``"pass"``.
+    """
     ratio = rms / np.maximum(expected, 1e-300)
     worst = int(np.argmax(ratio)) if len(ratio) else 0
     if len(ratio) and ratio[worst] > 5:

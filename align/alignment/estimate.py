@@ -1,24 +1,21 @@
 """Estimators of ``[M | b]`` from rate-table segments.
 
-Every segment becomes one linear observation of all three gyros,
-``y_k = [M | b] phi_k``:
+Every segment becomes one linear observation of all three gyros, ``y_k = [M | b] phi_k`` (SI units):
 
-* constant-rate dwell (Eq 19-30): ``y`` = mean reading, ``phi = [w_k; 1]``;
-* turn of known angle (Eq 31, integrated Eq 11-13): ``y`` = integrated reading,
+* constant-rate dwell (Eq 19-30): ``y`` = mean reading (rad/s), ``phi = [w_k; 1]``;
+* turn of known angle (Eq 31, integrated Eq 11-13): ``y`` = integrated reading (rad),
   ``phi = [theta_k u_k; T_k]`` (``T_k`` the duration, so a bias adds ``b T_k``);
-* static period: ``y`` = mean reading, ``phi = [w_earth; 1]`` (``[0; 1]`` without
-  an Earth-rate correction).
+* static period: ``y`` = mean reading, ``phi = [w_earth; 1]`` (``[0; 1]`` without an Earth-rate correction).
 
-:func:`fit_lsq` is the general weighted least squares over any set of segments
-(any axes, rates, lengths); :func:`fit_rate_pairs` (Eq 28-30) and
-:func:`fit_angle_pairs` (Eq 31) are the closed forms of the source, which it
-reproduces on their designs; :func:`two_axis` is the orthogonal shortcut
-(Eq 35-36).
+:func:`fit_lsq` is the general weighted least squares over any set of segments (any axes, rates,
+lengths); :func:`fit_rate_pairs` (Eq 28-30) and :func:`fit_angle_pairs` (Eq 31) are the closed
+forms of the source, which it reproduces on their designs; :func:`two_axis` is the orthogonal
+shortcut (Eq 35-36).
 
 Public names
 ------------
-Observation, Fit, observe, fit_lsq, fit_rate_pairs, fit_angle_pairs, two_axis,
-two_axis_error_bound, alignment_sigma
+Observation, Fit, observe, condition_number, fit_lsq, fit_rate_pairs, fit_angle_pairs, alignment_sigma
+(the two-axis shortcut, Eq 35-36, is in :mod:`align.alignment.twoaxis`)
 """
 
 from __future__ import annotations
@@ -31,16 +28,25 @@ from align.alignment.plan import Plan, axis_name
 from align.alignment.segment import Segment, integrate
 from align.earth import vertical_rate
 from align.errors import TestError
-from align.model import nearest_rotation
 from align.values import Value
 
 
 @dataclass(frozen=True, eq=False)
 class Observation(Value):
-    """One segment as a linear observation ``y = [M | b] phi`` (SI units).
+    """One segment as a linear observation ``y = [M | b] phi`` (SI units; see the module docstring).
 
-    ``var`` is the variance of each component of ``y`` from the noise inside
-    the segment (batch means for dwells, white noise for turns).
+    Attributes
+    ----------
+    segment : Segment
+    y : ndarray, shape (3,)
+        Mean reading of a dwell or static period (rad/s; m/s^2 for an accelerometer) or a turn's integrated reading (rad).
+    phi : ndarray, shape (4,)
+        ``[w u; 1]`` for a dwell (table rate ``w``, rad/s, times the step's unit axis), ``[w_earth; 1]``
+        or ``[0; 1]`` for a static period, ``[theta u; T]`` for a turn (angle, rad; duration, s).
+    var : ndarray, shape (3,)
+        Variance of ``y`` from the noise inside the segment (batch means for dwells, white noise for turns).
+    duration : float
+        s.
     """
 
     segment: Segment
@@ -57,8 +63,9 @@ class Fit(Value):
     Attributes
     ----------
     M, sigma_M : ndarray, shape (3, 3)
+        ``M`` of ``g = M w + b`` (Eq 14-15) and its 1-sigma, dimensionless; columns never turned about NaN.
     bias, sigma_bias : ndarray, shape (3,)
-        rad/s.
+        rad/s (m/s^2 for an accelerometer fit).
     cov : ndarray, shape (3, 4, 4)
         Covariance of each row ``[M_i1, M_i2, M_i3, b_i]``.
     residuals : ndarray, shape (k, 3)
@@ -70,6 +77,7 @@ class Fit(Value):
     condition_number : float
         Of the column-normalised design matrix.
     method : str
+        The estimator: ``"lsq"``, ``"two-axis"``, ``"ols"``, ``"rate"`` or ``"angle"``.
     """
 
     M: np.ndarray
@@ -111,8 +119,12 @@ def observe(t: np.ndarray, g: np.ndarray, segments: list[Segment], plan: Plan, s
     sigma : ndarray, shape (3,)
         Per-sample white-noise sigma, rad/s (for the variance of turns).
     earth : bool
-        Add the vertical Earth rate along the table axis (needs ``plan.latitude``);
-        it is then modelled in ``w`` instead of ending in the bias.
+        Add the vertical Earth rate along the table axis (needs ``plan.latitude``): modelled in ``w``, not left in ``b``.
+
+    Returns
+    -------
+    list of Observation
+        One per segment, in order.
     """
     dt = float(np.median(np.diff(t)))
     e_up = vertical_rate(plan.latitude) if earth and plan.latitude is not None else 0.0
@@ -138,14 +150,23 @@ def observe(t: np.ndarray, g: np.ndarray, segments: list[Segment], plan: Plan, s
 
 
 def _design(obs: list[Observation]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    phi = np.array([o.phi for o in obs])
-    y = np.array([o.y for o in obs])
-    var = np.array([o.var for o in obs])
-    return phi, y, var
+    """``phi`` (k, 4), ``y`` (k, 3) and ``var`` (k, 3) of the observations, stacked."""
+    return np.array([o.phi for o in obs]), np.array([o.y for o in obs]), np.array([o.var for o in obs])
 
 
 def condition_number(phi: np.ndarray) -> float:
-    """Condition number of the design with each column scaled to unit norm."""
+    """Condition number of the design with each column scaled to unit norm (which removes its units).
+
+    Parameters
+    ----------
+    phi : ndarray, shape (k, p)
+        The stacked regressors ``phi_k`` (rad/s, rad, s or 1).
+
+    Returns
+    -------
+    float
+        Largest over smallest singular value; ``inf`` when rank-deficient.
+    """
     norms = np.linalg.norm(phi, axis=0)
     norms[norms == 0] = 1.0
     s = np.linalg.svd(phi / norms, compute_uv=False)
@@ -155,21 +176,32 @@ def condition_number(phi: np.ndarray) -> float:
 def fit_lsq(obs: list[Observation], rate_accuracy: float = 0.0, method: str = "lsq", equal_weights: bool = False) -> Fit:
     """General weighted least squares for ``[M | b]`` (extends Eq 28-31).
 
-    Each gyro ``i`` is fitted separately: minimise
-    ``sum_k (y_ki - phi_k . x_i)^2 / var_ki``. The covariance is
-    ``(Phi^T W Phi)^-1``, inflated by ``chi2 / dof`` when that exceeds 1 (the
-    scatter between segments is larger than the noise inside them, e.g. bias
-    drift); a stated relative table accuracy (rate, or angle over the turn) adds ``(M_ij rate_accuracy)^2``.
+    Each gyro ``i`` is fitted separately: minimise ``sum_k (y_ki - phi_k . x_i)^2 / var_ki``. The
+    covariance is ``(Phi^T W Phi)^-1``, inflated by ``chi2 / dof`` when that exceeds 1 (the scatter
+    between segments is larger than the noise inside them, e.g. bias drift); a stated relative table
+    accuracy (rate, or angle over the turn) adds ``(M_ij rate_accuracy)^2``.
+    Columns of ``M`` for axes never turned about are left NaN (the two-axis shortcut fills them).
+    With ``equal_weights`` it is ordinary least squares, ``K = Y X^T (X X^T)^-1`` (reference
+    section 5), and the covariance is scaled by the residual variance ``chi2 / dof`` alone. Raises
+    TestError when the segments do not determine the turned columns and ``b``.
 
-    Columns of ``M`` for axes never turned about are left NaN (the two-axis
-    shortcut fills them). With ``equal_weights`` it is ordinary least squares,
-    ``K = Y X^T (X X^T)^-1`` (reference section 5), and the covariance is scaled
-    by the residual variance ``chi2 / dof`` alone.
+    Parameters
+    ----------
+    obs : list of Observation, length k
+        From :func:`observe`: ``y`` (3,) a mean reading (rad/s; m/s^2 for an accelerometer)
+        or a turn's integrated reading (rad); ``phi`` (4,) ``[w u; 1]``, ``[0; 1]`` or
+        ``[theta u; T]``; ``var`` (3,) the variance of ``y``. Static periods or +/- pairs fix ``b``.
+    rate_accuracy : float
+        Relative table accuracy (rate, or angle over the turn), dimensionless; 0 adds nothing.
+    method : str
+        The label recorded in :attr:`Fit.method` (``"lsq"``, ``"two-axis"``, ``"ols"``).
+    equal_weights : bool
+        Ordinary instead of weighted least squares (``var`` ignored).
 
-    Raises
-    ------
-    TestError
-        When the segments do not determine the turned columns and ``b``.
+    Returns
+    -------
+    Fit
+        ``M`` (3, 3), dimensionless, ``b`` (3,), rad/s (m/s^2), their covariance, residuals (k, 3), ``chi2``.
     """
     phi, y, var = _design(obs)
     if equal_weights:
@@ -177,14 +209,10 @@ def fit_lsq(obs: list[Observation], rate_accuracy: float = 0.0, method: str = "l
     k = len(obs)
     active = np.flatnonzero(np.linalg.norm(phi, axis=0) > 0)
     if np.linalg.matrix_rank(phi[:, active] / np.linalg.norm(phi[:, active], axis=0)) < len(active) or 3 not in active:
-        raise TestError(
-            "the segments do not determine M and the bias together: "
-            "turn about each axis and add +/- pairs or static periods"
-        )
-    x = np.full((3, 4), np.nan)
-    cov = np.full((3, 4, 4), np.nan)
-    chi2 = np.empty(3)
-    resid = np.empty((k, 3))
+        raise TestError("the segments do not determine M and the bias together: "
+                        "turn about each axis and add +/- pairs or static periods")
+    x, cov = np.full((3, 4), np.nan), np.full((3, 4, 4), np.nan)
+    chi2, resid = np.empty(3), np.empty((k, 3))
     dof = k - len(active)
     sub = np.ix_(active, active)
     for i in range(3):
@@ -228,13 +256,25 @@ def _pairs(obs: list[Observation], plan: Plan, kind: str) -> dict[int, tuple[Obs
 def fit_rate_pairs(obs: list[Observation], plan: Plan) -> Fit:
     """Eq 28-30: ``M_ij = (g_i(+) - g_i(-)) / (w(+) - w(-))``, ``b = mean of (g(+) + g(-)) / 2``.
 
-    With the table turning at ``+w`` and ``-w`` this is the source's
-    ``(g(+) - g(-)) / (2 w)``; the bias is the average over the three pairs of
-    the pairwise bias, assuming equal rates.
+    With the table turning at ``+w`` and ``-w`` this is the source's ``(g(+) - g(-)) / (2 w)``; the
+    bias is the average over the three pairs of the pairwise bias, assuming equal rates.
+
+    Parameters
+    ----------
+    obs : list of Observation
+        Constant-rate dwells (:func:`observe`): ``y`` (3,) the mean gyro reading, rad/s;
+        ``phi`` (4,) ``[w u; 1]``, table rate ``w`` in rad/s; ``var`` (3,), (rad/s)^2. The last
+        ``+w`` and ``-w`` dwell about each axis are used (TestError when one is missing).
+    plan : Plan
+        The plan the segments' steps refer to (axis, sign and rate of each step).
+
+    Returns
+    -------
+    Fit
+        ``M`` (3, 3), dimensionless, ``b`` (3,), rad/s, 1-sigma from the dwells' noise; ``chi2`` NaN.
     """
     pairs = _pairs(obs, plan, "rate")
-    m = np.empty((3, 3))
-    var_m = np.empty((3, 3))
+    m, var_m = np.empty((3, 3)), np.empty((3, 3))
     biases, var_b = [], []
     for a, (p, n) in pairs.items():
         span = p.phi[a] - n.phi[a]
@@ -251,10 +291,23 @@ def fit_rate_pairs(obs: list[Observation], plan: Plan) -> Fit:
 def fit_angle_pairs(obs: list[Observation], plan: Plan) -> Fit:
     """Eq 31: ``M_ij = (Theta_i(+) - Theta_i(-)) / (theta(+) - theta(-))``.
 
-    The bias cancels when both turns last equally long; otherwise the bias
-    from the static periods (their mean) is removed first. The bias reported is
-    that static mean (or, with no static period, the pairwise value assuming
-    equal durations).
+    The bias cancels when both turns last equally long; otherwise the static periods' mean bias is removed
+    first and reported (with no static period, the pairwise bias assuming equal durations is reported).
+
+    Parameters
+    ----------
+    obs : list of Observation
+        Turns and static periods (:func:`observe`): for a turn ``y`` (3,) is the integrated
+        reading ``Theta_i``, rad, and ``phi`` (4,) ``[theta u; T]`` (table angle, rad; duration, s);
+        for a static period ``y`` is the mean reading, rad/s. The last ``+theta`` and ``-theta``
+        turn about each axis are used (TestError when one is missing).
+    plan : Plan
+        The plan the segments' steps refer to (axis, sign and angle of each step).
+
+    Returns
+    -------
+    Fit
+        ``M`` (3, 3), dimensionless, ``b`` (3,), rad/s (sigma NaN without a static period); ``chi2`` NaN.
     """
     pairs = _pairs(obs, plan, "angle")
     statics = [o for o in obs if o.segment.kind == "static"]
@@ -264,8 +317,7 @@ def fit_angle_pairs(obs: list[Observation], plan: Plan) -> Fit:
         sigma_b = np.sqrt(np.sum([o.var * wi**2 for o, wi in zip(statics, w)], axis=0)) / w.sum()
     else:
         bias, sigma_b = None, None
-    m = np.empty((3, 3))
-    var_m = np.empty((3, 3))
+    m, var_m = np.empty((3, 3)), np.empty((3, 3))
     pair_bias = []
     for a, (p, n) in pairs.items():
         span = p.phi[a] - n.phi[a]
@@ -291,54 +343,20 @@ def _closed_form_fit(obs, m, bias, sigma_m, sigma_b, method) -> Fit:
     return Fit(m, bias, sigma_m, sigma_b, cov, resid, len(obs) - 4, np.full(3, np.nan), condition_number(phi), method)
 
 
-def two_axis(fit: Fit, missing: int, variant: str = "procrustes") -> np.ndarray:
-    """Complete ``M`` from two measured columns, assuming orthogonal gyros (Eq 35-36).
+def alignment_sigma(m: np.ndarray, cov: np.ndarray) -> np.ndarray:
+    """1-sigma of ``A = M^-1`` (Eq 14-15) by first-order propagation ``dA = -A dM A``.
 
     Parameters
     ----------
-    fit : Fit
-        A fit whose columns other than ``missing`` are measured.
-    missing : int
-        The axis not turned about (0, 1, 2).
-    variant : {"procrustes", "cross"}
-        ``"cross"``: the source's cross product of the two measured columns
-        (Eq 36, e.g. ``M11 = M22 M33 - M32 M23``). ``"procrustes"``: the nearest
-        rotation to the two measured columns (SVD of ``C E^T``), whose third
-        column is used; unlike the cross product it is not scaled by the
-        gyros' scale errors.
+    m : ndarray, shape (3, 3)
+        The estimated ``M``, dimensionless.
+    cov : ndarray, shape (3, 4, 4)
+        Covariance of each (independent) row ``[M_i1, M_i2, M_i3, b_i]``; only the ``M`` block is used.
 
     Returns
     -------
     ndarray, shape (3, 3)
-    """
-    m = fit.M.copy()
-    j, k = (missing + 1) % 3, (missing + 2) % 3
-    if variant == "cross":
-        m[:, missing] = np.cross(m[:, j], m[:, k])
-    elif variant == "procrustes":
-        e = np.eye(3)[:, [j, k]]
-        c = m[:, [j, k]]
-        r = nearest_rotation(c @ e.T)
-        m[:, missing] = r[:, missing]
-    else:
-        raise ValueError(f"unknown two-axis variant {variant!r}")
-    return m
-
-
-def two_axis_error_bound(axis_to_axis: float) -> float:
-    """Direction error (rad) of the inferred column for a stated axis-to-axis spec.
-
-    To first order the inferred column's off-axis elements are each in error by
-    the true ``delta_ij`` of the gyro pairs involving the missing axis, so the
-    column's direction is off by up to ``sqrt(2) * spec``.
-    """
-    return float(np.sqrt(2.0) * axis_to_axis)
-
-
-def alignment_sigma(m: np.ndarray, cov: np.ndarray) -> np.ndarray:
-    """1-sigma of ``A = M^-1`` by first-order propagation ``dA = -A dM A``.
-
-    ``cov`` holds each row's covariance (3, 4, 4); rows are independent.
+        1-sigma of each element of ``A``, dimensionless.
     """
     a = np.linalg.inv(m)
     var = np.zeros((3, 3))

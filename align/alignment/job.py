@@ -25,22 +25,17 @@ from align.alignment.checks import (
     check_scale,
     check_span,
 )
-from align.alignment.estimate import (
-    alignment_sigma,
-    fit_angle_pairs,
-    fit_lsq,
-    fit_rate_pairs,
-    observe,
-    two_axis,
-    two_axis_error_bound,
-)
+from align.alignment.estimate import alignment_sigma, fit_angle_pairs, fit_lsq, fit_rate_pairs, observe
 from align.alignment.plan import Plan
 from align.alignment.segment import Segment, SegmentOptions, noise_sigma, segment_log
+from align.alignment.twoaxis import two_axis, two_axis_error_bound
 from align.earth import EARTH_RATE, vertical_rate
 from align.errors import InputError
 from align.io import c_header, check_log
+from align.io.keys import check_keys
 from align.model import Angles, SensorModel, angles, check_handedness
-from align.results import Result, file_unit
+from align.plausible import array_field, malformed
+from align.results import Result, envelope, file_unit
 from align.units import DEG, DEG_H, parse_unit, to_unit
 from align.values import Value
 
@@ -144,8 +139,12 @@ class AlignmentResult(Result, format=FORMAT, version=FORMAT_VERSION, convention=
         return self.model.correct(g)
 
     def correction(self, sensor: str | None = None, where: str = "result") -> AlignmentResult:
-        """This result, which corrects gyro logs (see :class:`align.results.Correction`)."""
-        return self._only_sensor("gyroscope", sensor, where)
+        """This result, which corrects gyro logs (see :class:`align.results.Correction`).
+
+        Refuses (naming ``where``) an ``M`` that is not finite, singular or has ``det <= 0``
+        (:func:`align.plausible.check_usable_model`).
+        """
+        return self._only_sensor("gyroscope", sensor, where, "M")
 
     def as_c_header(self, comment: str, name: str = "IMU_ALIGN") -> str:
         """A C header with ``A`` and the bias (in :attr:`units`) for ``w = A (g - b)`` in firmware."""
@@ -197,9 +196,12 @@ class AlignmentResult(Result, format=FORMAT, version=FORMAT_VERSION, convention=
     def from_dict(cls, d: dict, where: str = "result") -> AlignmentResult:
         """Read the form written by :meth:`to_dict` (any version up to the current one)."""
         cls.check_envelope(d, where)
+        known = ("sensor", "method", "M", "A", "bias", "uncertainty", "angles", "condition_number", "dof", "inferred_axis",
+                 "segments", "checks", "notes", "inputs")  # after the envelope; a misspelled key is refused, not ignored
+        check_keys(d, [*envelope(cls.FORMAT, cls.VERSION, cls.CONVENTION), *known], where)
         try:
             u, f = file_unit(d, "bias", "angular_rate", where)
-            m = np.array(d["M"], float).reshape(3, 3)
+            m = array_field(d, "M", (3, 3), "alignment result", where)
             unc = d.get("uncertainty", {})
             segs = tuple(
                 SegmentReport(s["name"], s["kind"], s["start"], s["end"], s["t_start"], s["t_end"],
@@ -208,9 +210,10 @@ class AlignmentResult(Result, format=FORMAT, version=FORMAT_VERSION, convention=
                 for s in d.get("segments", [])
             )
             inferred = d.get("inferred_axis")
+            a = array_field(d, "A", (3, 3), "alignment result", where)
+            bias = array_field(d, "bias", (3,), "alignment result", where, f)
             return cls(
-                method=d["method"], M=m, A=np.array(d["A"], float).reshape(3, 3),
-                bias=np.array(d["bias"], float).reshape(3) * f,
+                method=d["method"], M=m, A=a, bias=bias,
                 sigma_M=np.array(unc.get("M", np.full((3, 3), np.nan)), float).reshape(3, 3),
                 sigma_A=np.array(unc.get("A", np.full((3, 3), np.nan)), float).reshape(3, 3),
                 sigma_bias=np.array(unc.get("bias", [np.nan] * 3), float).reshape(3) * f,
@@ -222,7 +225,8 @@ class AlignmentResult(Result, format=FORMAT, version=FORMAT_VERSION, convention=
                 inputs=dict(d.get("inputs", {})),
             )
         except (KeyError, TypeError, ValueError) as exc:
-            raise InputError(f"malformed alignment result ({exc!r}); regenerate it with imu-align matrix", where) from None
+            raise InputError(f"malformed alignment result ({malformed(exc)}); regenerate it with imu-align matrix",
+                             where) from None
 
 
 def _measured_turns(obs, plan: Plan, bias: np.ndarray):

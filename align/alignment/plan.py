@@ -7,17 +7,19 @@ a positive rate or angle is a right-handed turn about that axis.
 
 Public names
 ------------
-Step, Plan, parse_axis, axis_name
+Step, Plan, parse_axis, axis_name, check_turn, PLAN_KEYS, TEST_KEYS, STEP_KEYS, MAX_RATE_DEG_S, MAX_ANGLE_DEG
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from align.errors import InputError
-from align.units import format_quantity, parse_quantity
+from align.errors import InputError, literal
+from align.io.keys import check_keys, table, tables
+from align.units import DEG, DEG_S, format_quantity, parse_quantity
 
 _AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 
@@ -28,7 +30,7 @@ def parse_axis(text: str, where: str | None = None) -> tuple[int, int]:
     sign = -1 if t.startswith("-") else 1
     name = t.lstrip("+-")
     if name not in _AXIS_INDEX:
-        raise InputError(f"axis '{text}' is not one of +x, -x, +y, -y, +z, -z", where)
+        raise InputError(f"axis '{literal(text)}' is not one of +x, -x, +y, -y, +z, -z", where)
     return _AXIS_INDEX[name], sign
 
 
@@ -105,39 +107,30 @@ class Plan:
 
     @classmethod
     def from_dict(cls, data: dict, where: str = "plan") -> Plan:
-        """Build a plan from the parsed TOML (see module docstring)."""
-        raw = data.get("step")
-        if not isinstance(raw, list) or not raw:
+        """Build a plan from the parsed TOML (see module docstring).
+
+        Every table is checked for unknown keys (:data:`PLAN_KEYS`, :data:`TEST_KEYS`,
+        :data:`STEP_KEYS`); every value for its domain (a step turns the table: a
+        finite, non-zero rate or angle; ``|latitude| <= 90 deg``; accuracies finite,
+        not negative, ``rate_accuracy`` under 100 %).
+        """
+        check_keys(data, PLAN_KEYS, where)
+        raw = tables(data, "step", where)
+        if not raw:
             raise InputError("no [[step]] tables: list the table steps in the order they were run", where)
-        steps = []
-        for k, item in enumerate(raw, start=1):
-            here = f"{where}: step {k}"
-            if not isinstance(item, dict) or "axis" not in item:
-                raise InputError("missing 'axis' (e.g. axis = \"+x\")", here)
-            axis, sign = parse_axis(item["axis"], here)
-            has_rate, has_angle = "rate" in item, "angle" in item
-            if has_rate == has_angle:
-                raise InputError("give exactly one of 'rate' (e.g. \"100 deg/s\") or 'angle' (e.g. \"-360 deg\")", here)
-            if has_rate:
-                value = parse_quantity(item["rate"], "angular_rate", f"{here}.rate")
-                steps.append(Step(axis, sign, rate=value))
-            else:
-                value = parse_quantity(item["angle"], "angle", f"{here}.angle")
-                steps.append(Step(axis, sign, angle=value))
-            if value == 0:
-                raise InputError("rate or angle is zero; a step must turn the table", here)
-        test = data.get("test", {})
-        if not isinstance(test, dict):
-            raise InputError("[test] must be a table", where)
+        steps = tuple(_step(item, f"{where}: step {k}") for k, item in enumerate(raw, start=1))
+        test = table(data, "test", where)
+        check_keys(test, TEST_KEYS, f"{where}: [test]")
         lat = test.get("latitude")
         latitude = None if lat is None else parse_quantity(lat, "angle", f"{where}: test.latitude")
         if latitude is not None and abs(latitude) > np.pi / 2:
             raise InputError("latitude must lie within +/-90 deg", f"{where}: test.latitude")
-        rate_acc = parse_quantity(test.get("rate_accuracy", "0 %"), "dimensionless", f"{where}: test.rate_accuracy")
-        angle_acc = parse_quantity(test.get("angle_accuracy", "0 deg"), "angle", f"{where}: test.angle_accuracy")
-        if rate_acc < 0 or angle_acc < 0:
-            raise InputError("accuracies must not be negative", f"{where}: test")
-        return cls(tuple(steps), latitude, rate_acc, angle_acc)
+        rate_acc = _accuracy(test, "rate_accuracy", "dimensionless", "0 %", where)
+        if rate_acc >= 1:
+            raise InputError(f"{format_quantity(rate_acc, '%', 4)} is not a table-rate accuracy: it must be under "
+                             "100 % (e.g. \"0.01 %\")", f"{where}: test.rate_accuracy")
+        angle_acc = _accuracy(test, "angle_accuracy", "angle", "0 deg", where)
+        return cls(steps, latitude, rate_acc, angle_acc)
 
     def to_toml(self) -> str:
         """The plan as TOML text that :meth:`from_dict` reads back."""
@@ -161,12 +154,64 @@ class Plan:
 
     @classmethod
     def standard_rate(cls, rate: float, latitude: float | None = None) -> Plan:
-        """The six-dwell +/- rate plan about x, y, z (Eq 28-30); ``rate`` in rad/s."""
+        """The six-dwell +/- rate plan about x, y, z (Eq 28-30); ``rate`` in rad/s (refused when zero or beyond a table)."""
+        check_turn(rate, "rate", "{rate}")
         steps = tuple(Step(a, 1, rate=r) for a in range(3) for r in (rate, -rate))
         return cls(steps, latitude)
 
     @classmethod
     def standard_angle(cls, angle: float) -> Plan:
-        """Six turns, +/- ``angle`` (rad) about x, y, z (Eq 31)."""
+        """Six turns, +/- ``angle`` (rad) about x, y, z (Eq 31); refused when zero or beyond a table."""
+        check_turn(angle, "angle", "{angle}")
         steps = tuple(Step(a, 1, angle=t) for a in range(3) for t in (angle, -angle))
         return cls(steps)
+
+
+#: the keys of a plan file, of its [test] table and of each [[step]]
+PLAN_KEYS = ("test", "step")
+TEST_KEYS = ("latitude", "rate_accuracy", "angle_accuracy")
+STEP_KEYS = ("axis", "rate", "angle")
+#: the largest table rate (deg/s) and turn (deg) a step may ask for: beyond, the number or unit is wrong
+MAX_RATE_DEG_S, MAX_ANGLE_DEG = 1e5, 1e5
+
+
+def _step(item: dict, here: str) -> Step:
+    """One ``[[step]]`` table; ``here`` names it ("plan.toml: step 3")."""
+    check_keys(item, STEP_KEYS, here)
+    if "axis" not in item:
+        raise InputError("missing 'axis' (e.g. axis = \"+x\")", here)
+    axis, sign = parse_axis(item["axis"], here)
+    has_rate, has_angle = "rate" in item, "angle" in item
+    if has_rate == has_angle:
+        raise InputError("give exactly one of 'rate' (e.g. \"100 deg/s\") or 'angle' (e.g. \"-360 deg\")", here)
+    if has_rate:
+        rate = check_turn(parse_quantity(item["rate"], "angular_rate", f"{here}.rate"), "rate", f"{here}.rate")
+        return Step(axis, sign, rate=rate)
+    angle = check_turn(parse_quantity(item["angle"], "angle", f"{here}.angle"), "angle", f"{here}.angle")
+    return Step(axis, sign, angle=angle)
+
+
+def check_turn(value: float, kind: str, where: str) -> float:
+    """``value`` (rad/s for ``kind="rate"``, rad for ``"angle"``) when a table can turn by it.
+
+    A step must turn the table (non-zero) within what a rate table does (at most
+    :data:`MAX_RATE_DEG_S` deg/s or :data:`MAX_ANGLE_DEG` deg); ``where`` names
+    the field ("plan.toml: step 3.rate") or the input (``"{rate}"``).
+    """
+    if not math.isfinite(value):
+        raise InputError(f"{kind} is {value}, not a finite number", where)
+    if value == 0:
+        raise InputError(f"{kind} is zero; a step must turn the table", where)
+    unit, most = ("deg/s", MAX_RATE_DEG_S * DEG_S) if kind == "rate" else ("deg", MAX_ANGLE_DEG * DEG)
+    if not abs(value) <= most:
+        raise InputError(f"{format_quantity(value, unit, 4)} is beyond any rate table (at most "
+                         f"{format_quantity(most, unit, 6)}); check the number and its unit", where)
+    return value
+
+
+def _accuracy(test: dict, key: str, expect: str, default: str, where: str) -> float:
+    """A finite, non-negative accuracy of ``[test]``."""
+    value = parse_quantity(test.get(key, default), expect, f"{where}: test.{key}")
+    if not math.isfinite(value) or value < 0:
+        raise InputError(f"must be a finite accuracy, zero or more; got {literal(repr(test[key]))}", f"{where}: test.{key}")
+    return value

@@ -20,7 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from align.alignment.plan import Plan
-from align.errors import InputError, TestError
+from align.errors import InputError, TestError, literal
+from align.io.keys import check_keys, require_keys
 from align.units import DEG_S, unit_mixup_hint
 
 
@@ -251,19 +252,40 @@ def _merge_similar(g: np.ndarray, runs: list[tuple[int, int]], tol: float, max_g
     return out
 
 
+#: the keys of one range of an explicit segments file
+RANGE_KEYS = ("start", "end")
+
+
+def _sample_range(name: str, rng: object, n: int, where: str) -> tuple[int, int]:
+    """``start``, ``end`` of one explicit range, checked: integers, ``0 <= start < end <= n``."""
+    here = f"{where}: {name}"
+    if not isinstance(rng, dict):
+        raise InputError(f"must be an object {{\"start\": i, \"end\": j}} of sample indices, got {literal(repr(rng))}", here)
+    check_keys(rng, RANGE_KEYS, here)
+    require_keys(rng, {"start": '"start": 0', "end": '"end": 1000'}, here)
+    a, b = rng["start"], rng["end"]
+    if not all(isinstance(v, int) and not isinstance(v, bool) for v in (a, b)):
+        raise InputError(f"start={literal(repr(a))}, end={literal(repr(b))}: sample indices must be whole numbers", here)
+    if not 0 <= a < b <= n:
+        raise InputError(f"start={a}, end={b} is not a sample range inside the log's {n} rows", here)
+    return a, b
+
+
 def segments_from_ranges(ranges: dict, plan: Plan, n: int, where: str = "segments") -> list[Segment]:
     """Segments from explicit sample ranges ``{name: {"start": i, "end": j}}`` (imucal's form).
 
     Names beginning with ``static`` are static periods; the others are matched to
-    the plan's steps in file order. ``end`` is exclusive.
+    the plan's steps in file order. ``end`` is exclusive. Each range holds just
+    ``start`` and ``end`` (integers, ``0 <= start < end <= n``); ranges must not
+    overlap.
     """
     segs, k = [], 0
     for name, rng in ranges.items():
-        if not isinstance(rng, dict) or "start" not in rng or "end" not in rng:
-            raise InputError("needs integer 'start' and 'end' sample indices", f"{where}: {name}")
-        a, b = rng["start"], rng["end"]
-        if not (isinstance(a, int) and isinstance(b, int)) or not 0 <= a < b <= n:
-            raise InputError(f"start={a!r}, end={b!r} is not a sample range inside the log's {n} rows", f"{where}: {name}")
+        a, b = _sample_range(str(name), rng, n, where)
+        for other in segs:
+            if a < other.end and other.start < b:
+                raise InputError(f"samples {a}-{b} overlap '{literal(other.name)}' ({other.start}-{other.end}); "
+                                 "a sample belongs to one segment", f"{where}: {name}")
         if str(name).lower().startswith("static"):
             segs.append(Segment(str(name), "static", a, b))
             continue

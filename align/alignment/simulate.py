@@ -22,8 +22,10 @@ from align import CONVENTION
 from align.alignment.plan import Plan
 from align.earth import earth_rate_in_frame
 from align.errors import InputError
+from align.io.keys import check_keys
 from align.model import SensorModel
-from align.results import Result, file_unit
+from align.plausible import malformed
+from align.results import Result, envelope, file_unit
 from align.units import DEG, DEG_S, to_unit
 
 
@@ -69,6 +71,25 @@ class SessionSpec:
     latitude: float | None = None
     gyro_range: float | None = None
 
+    def __post_init__(self) -> None:
+        """Refuse values outside their domain, each named as its input (``{dwell_s}``, ``{fs}``)."""
+        rules = {"fs": (self.fs, 0.0, True), "dwell_s": (self.dwell_s, 0.0, True), "static_s": (self.static_s, 0.0, False),
+                 "accel": (self.accel, 0.0, True), "turn_rate": (self.turn_rate, 0.0, True),
+                 "noise_density": (self.noise_density, 0.0, False), "bias_walk": (self.bias_walk, 0.0, False),
+                 "table_rate_error": (self.table_rate_error, -1.0, True),
+                 "table_angle_error": (self.table_angle_error, -1.0, True)}
+        if self.gyro_range is not None:
+            rules["gyro_range"] = (self.gyro_range, 0.0, True)
+        for name, (x, low, strict) in rules.items():
+            if not (np.isfinite(x) and (x > low if strict else x >= low)):
+                raise InputError(f"must be finite and {'>' if strict else '>='} {low:g} (got {float(x):g})", "{" + name + "}")
+        if self.latitude is not None and not (np.isfinite(self.latitude) and abs(self.latitude) <= np.pi / 2):
+            raise InputError(f"must lie within -90 and 90 deg (got {float(self.latitude) / DEG:g} deg)", "{latitude}")
+
+
+#: the most samples a simulated session may hold (about 5 GB of arrays)
+MAX_SAMPLES = 200_000_000
+
 
 def _profile(step, spec: SessionSpec) -> np.ndarray:
     """Table rate magnitude profile (signed, rad/s) for one step, without gaps."""
@@ -93,6 +114,22 @@ def _profile(step, spec: SessionSpec) -> np.ndarray:
     return prof
 
 
+def _check_size(plan: Plan, spec: SessionSpec) -> None:
+    """Refuse a session too long to hold in memory, before any array is made (a bound from above:
+    each step's ramps, its dwell or its turn at the slowest cruise, and the gaps)."""
+    seconds = (len(plan.steps) + 1) * spec.static_s
+    for step in plan.steps:
+        if step.rate is not None:
+            seconds += spec.dwell_s + 2 * abs(step.rate) * (1 + abs(spec.table_rate_error)) / spec.accel
+        else:
+            total = abs(step.angle) * (1 + abs(spec.table_angle_error))
+            seconds += total / min(spec.turn_rate, np.sqrt(total * spec.accel)) + 2 * spec.turn_rate / spec.accel
+    n = seconds * spec.fs
+    if not n <= MAX_SAMPLES:
+        raise InputError(f"the session would hold about {n:.3g} samples, more than {MAX_SAMPLES:.0e}: shorten "
+                         "{dwell_s} or {static_s}, or lower {fs}", "simulation")
+
+
 def simulate_session(plan: Plan, model: SensorModel, spec: SessionSpec = SessionSpec(), seed: int | np.random.Generator = 0):
     """Simulate the gyro log of a rate-table session.
 
@@ -115,6 +152,7 @@ def simulate_session(plan: Plan, model: SensorModel, spec: SessionSpec = Session
         True angular rate of the system frame, rad/s (table plus Earth).
     """
     rng = np.random.default_rng(seed)
+    _check_size(plan, spec)
     gap = np.zeros(int(round(spec.static_s * spec.fs)))
     pieces, axes = [], []
     for step in plan.steps:
@@ -143,6 +181,9 @@ def simulate_session(plan: Plan, model: SensorModel, spec: SessionSpec = Session
     g = w @ model.M.T + bias + rng.standard_normal((n, 3)) * spec.noise_density * np.sqrt(spec.fs)
     if spec.gyro_range is not None:
         g = np.clip(g, -spec.gyro_range, spec.gyro_range)
+    if not np.isfinite(g).all():
+        raise InputError("the simulated readings overflow (not finite): lower {noise_density} or {bias_walk}",
+                         "simulation")
     return np.arange(n) * dt, g, w
 
 
@@ -189,9 +230,10 @@ class SimulationTruth(Result, format="imu-align.truth", convention=CONVENTION):
     @classmethod
     def from_dict(cls, d: dict, where: str = "truth") -> SimulationTruth:
         cls.check_envelope(d, where)
+        check_keys(d, [*envelope(cls.FORMAT, cls.VERSION, cls.CONVENTION), "M", "A", "bias", "seed", "inputs"], where)
         try:
             u, f = file_unit(d, "bias", "angular_rate", where)
             return cls(SensorModel(np.array(d["M"], float), np.array(d["bias"], float) * f), u, d.get("seed"),
                        dict(d.get("inputs", {})))
         except (KeyError, TypeError, ValueError) as exc:
-            raise InputError(f"malformed simulation truth ({exc!r})", where) from None
+            raise InputError(f"malformed simulation truth ({malformed(exc)}); regenerate it", where) from None

@@ -7,6 +7,7 @@ Modules
 -------
 results       Calibration (one sensor's ``[M | b]``) and CalibrationSet (the ``imu-align.calibration`` file)
 accel         accelerometer: multi-position least squares, the ``|a| = g`` fit, sessions from a log
+positions     the positions file of an accelerometer session (``gravity``, ``[[position]]`` tables), keys checked
 ferraris      Ferraris sessions (six faces and three turns, as imucal records them): accelerometer and gyro
 ellipsoid     algebraic ellipsoid fits and the soft-iron parametrisation
 magnetometer  MagCalibration (the ``imu-align.magnetometer`` file): hard and soft iron with gates,
@@ -15,7 +16,7 @@ magnetometer  MagCalibration (the ``imu-align.magnetometer`` file): hard and sof
 Public names
 ------------
 Calibration, CalibrationSet, SENSORS, FACES, face_ups, static_means, accel_session, calibrate_accel_log,
-StaticDetector, calibrate_accel,
+StaticDetector, calibrate_accel, Position, parse_positions, positions_of,
 calibrate_accel_free, ferraris, sections_from_dict, SECTIONS, MagCalibration, calibrate_magnetometer, with_gravity_alignment,
 alignment_to_gravity, misalignment_from_axes_down, MODELS
 """
@@ -39,10 +40,11 @@ from align.calibration.magnetometer import (
                                      misalignment_from_axes_down,
                                      with_gravity_alignment,
 )
+from align.calibration.positions import Position, parse_positions, positions_of
 from align.calibration.results import SENSORS, Calibration, CalibrationSet
 
 __all__ = ["Calibration", "CalibrationSet", "SENSORS", "FACES", "face_ups", "static_means", "accel_session",
-           "calibrate_accel_log", "StaticDetector",
+           "calibrate_accel_log", "StaticDetector", "Position", "parse_positions", "positions_of",
            "calibrate_accel", "calibrate_accel_free", "ferraris", "sections_from_dict", "SECTIONS", "MagCalibration",
            "calibrate_magnetometer", "with_gravity_alignment", "alignment_to_gravity",
            "misalignment_from_axes_down", "MODELS"]

@@ -15,7 +15,8 @@ The accelerometer shares the alignment convention ``raw = M true + bias``
 
 Public names
 ------------
-FACES, face_ups, static_means, accel_session, calibrate_accel_log, StaticDetector, calibrate_accel, calibrate_accel_free
+FACES, face_ups, static_means, norms_at_rest, accel_session, calibrate_accel_log, StaticDetector, calibrate_accel,
+calibrate_accel_free
 """
 
 from __future__ import annotations
@@ -25,12 +26,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from align.alignment.estimate import Observation, fit_lsq
-from align.alignment.plan import parse_axis
 from align.alignment.segment import Segment, static_intervals
+from align.calibration.positions import parse_positions, positions_of
 from align.calibration.results import Calibration
-from align.errors import InputError, TestError
+from align.errors import InputError, TestError, literal
 from align.io import check_log
-from align.units import STANDARD_GRAVITY, parse_quantity
+from align.plausible import check_at_rest, check_axes, check_gravity, check_scale_factors
+from align.units import STANDARD_GRAVITY, parse_quantity, to_unit
 
 #: imucal's section names -> the axis pointing up (the accelerometer reads +g on it)
 FACES = {"x_p": (0, 1), "x_a": (0, -1), "y_p": (1, 1), "y_a": (1, -1), "z_p": (2, 1), "z_a": (2, -1)}
@@ -89,6 +91,12 @@ def static_means(x: np.ndarray, ranges: dict, max_spread: float, where: str = ""
     return out
 
 
+def norms_at_rest(x: np.ndarray, ranges: dict) -> np.ndarray:
+    """``|x|`` of every sample in the named ranges ``(start, end)`` (clipped to the log), shape (k,)."""
+    parts = [np.linalg.norm(x[max(a, 0):b], axis=1) for a, b in ranges.values()]
+    return np.concatenate(parts) if parts else np.zeros(0)
+
+
 @dataclass(frozen=True)
 class StaticDetector:
     """Settings of the static-interval detector (imu_tk's moving variance, see
@@ -111,7 +119,9 @@ def calibrate_accel_log(t: np.ndarray, a: np.ndarray, spec: dict | None, units: 
     t, a : ndarray, shapes (n,) and (n, 3)
         Time (s) and readings, SI or counts.
     spec : dict or None
-        The positions file (``gravity`` and ``[[position]]`` tables), or None for the ``|a| = g`` fit.
+        The positions file (``gravity`` and ``[[position]]`` tables, see
+        :mod:`align.calibration.positions`), or None for the ``|a| = g`` fit. A file
+        without positions is refused, not read as None.
     units : str
         Unit of the readings.
     gravity : float, optional
@@ -119,12 +129,17 @@ def calibrate_accel_log(t: np.ndarray, a: np.ndarray, spec: dict | None, units: 
     detector : StaticDetector
     """
     check_log(t, a, where)
-    spec = spec or {}
-    if gravity is None:
-        gravity = parse_quantity(spec.get("gravity", f"{STANDARD_GRAVITY} m/s^2"), "acceleration", f"{positions_file}: gravity")
+    positions = None if spec is None else positions_of(spec, positions_file)
+    if gravity is not None:
+        gravity = check_gravity(gravity)
+    elif spec is not None and "gravity" in spec:
+        at = f"{positions_file}: gravity"
+        gravity = check_gravity(parse_quantity(spec["gravity"], "acceleration", at), at)
+    else:
+        gravity = STANDARD_GRAVITY
     fs = 1.0 / float(np.median(np.diff(t)))
     intervals = static_intervals(a, fs, detector.window_s, detector.factor, detector.init_static_s, detector.min_static_s)
-    return accel_session(t, a, intervals, spec.get("position"), gravity, units, where, positions_file)
+    return accel_session(t, a, intervals, positions, gravity, units, where, positions_file)
 
 
 def accel_session(t: np.ndarray, a: np.ndarray, intervals: list, positions: list | None, gravity: float,
@@ -140,7 +155,8 @@ def accel_session(t: np.ndarray, a: np.ndarray, intervals: list, positions: list
         used when the positions give no ``start``/``end`` (matched in order) and
         for the free fit.
     positions : list of dict or None
-        Each with ``up`` (``"+x"`` or ``[x, y, z]``), optional ``name``, ``start``, ``end``, ``holdout``.
+        Each with ``up`` (``"+x"`` or ``[x, y, z]``), optional ``name``, ``start``, ``end``, ``holdout``
+        (:func:`align.calibration.positions.parse_positions`); None for the ``|a| = g`` fit.
     gravity : float
         Local gravity, m/s^2.
     units : str
@@ -151,44 +167,58 @@ def accel_session(t: np.ndarray, a: np.ndarray, intervals: list, positions: list
     Returns
     -------
     Calibration
+
+    Raises
+    ------
+    TestError
+        Readings at rest that are not gravity in ``units`` (a unit mix-up, named with its fix ``{units=...}``),
+        positions that do not match the detected intervals, a handedness error.
     """
+    gravity = check_gravity(gravity)
     if positions is None:
-        means = static_means(a, {f"interval {k + 1}": r for k, r in enumerate(intervals)}, 0.02, f"{where}: ")
+        if not intervals:
+            raise TestError("no static intervals detected: adjust the static detector ({factor}, {window_s}) "
+                            "or list the positions", where)
+        ranges = {f"interval {k + 1}": r for k, r in enumerate(intervals)}
+        check_at_rest(norms_at_rest(a, ranges), gravity, units, "units", where)
+        means = static_means(a, ranges, 0.02, f"{where}: ")
         cal = calibrate_accel_free(np.array(list(means.values())), gravity, units)
         note = f"{len(intervals)} static intervals detected automatically (moving variance)"
         return cal.replace(notes=cal.notes + (note,))
-    if not isinstance(positions, list) or not positions:
-        raise InputError("no [[position]] tables", positions_file)
-    if all("start" in p for p in positions):
-        ranges = [(int(p["start"]), int(p["end"])) for p in positions]
-    elif any("start" in p for p in positions):
-        raise InputError("give start/end for every position or for none (automatic detection)", positions_file)
+    parsed = parse_positions(positions, positions_file)
+    if parsed[0].samples is not None:
+        ranges = [p.samples for p in parsed]
     else:
-        if len(intervals) != len(positions):
+        if len(intervals) != len(parsed):
             found = "; ".join(f"t={t[s]:.1f}-{t[e - 1]:.1f} s" for s, e in intervals[:20])
-            raise TestError(f"{len(intervals)} static intervals detected but {len(positions)} positions listed ({found}); "
+            raise TestError(f"{len(intervals)} static intervals detected but {len(parsed)} positions listed ({found}); "
                             "adjust the static detector ({factor}, {window_s}) or give start/end per position", where)
         ranges = intervals
-    names, ups, hold = [], {}, []
-    for k, p in enumerate(positions, start=1):
-        name = str(p.get("name", f"position {k}"))
-        up = p.get("up")
-        if isinstance(up, str):
-            u = _axis_up(*parse_axis(up, f"{positions_file}: {name}.up"))
-        elif isinstance(up, list) and len(up) == 3:
-            u = np.asarray(up, float) / np.linalg.norm(up)
-        else:
-            raise InputError("up must be an axis ('+x') or a vector [x, y, z]", f"{positions_file}: {name}.up")
-        names.append(name)
-        ups[name] = u
-        if p.get("holdout"):
-            hold.append(name)
-    means = static_means(a, dict(zip(names, ranges, strict=True)), 0.02, f"{positions_file}: ")
-    return calibrate_accel(means, ups, gravity, units, tuple(hold))
+    named = {p.name: r for p, r in zip(parsed, ranges, strict=True)}
+    check_at_rest(norms_at_rest(a, named), gravity, units, "units", where)
+    means = static_means(a, named, 0.02, f"{positions_file}: ")
+    return calibrate_accel(means, {p.name: p.up for p in parsed}, gravity, units, tuple(p.name for p in parsed if p.holdout),
+                           where=positions_file)
+
+
+def _check_distinct(means: dict, ups: dict, where: str, units: str) -> None:
+    """Refuse two positions of different orientation that read the same (one face recorded twice, a copied range)."""
+    names = list(means)
+    centre = np.mean([means[k] for k in names], axis=0)
+    radius = float(np.median([np.linalg.norm(means[k] - centre) for k in names]))  # g times the scale, any unit
+    for i, k in enumerate(names):
+        for n in names[i + 1:]:
+            turn = float(np.linalg.norm(np.asarray(ups[k], float) - np.asarray(ups[n], float)))
+            apart = float(np.linalg.norm(means[k] - means[n]))
+            if turn > 0.5 and not apart > 0.25 * turn * radius:
+                raise TestError(f"positions {literal(k)} and {literal(n)} read the same ({to_unit(apart, units):.3g} {units} "
+                                f"apart, about {to_unit(turn * radius, units):.3g} expected for their orientations): one "
+                                f"face recorded twice or a range copied; check {literal(k)} and {literal(n)}", where)
 
 
 def calibrate_accel(means: dict, ups: dict, gravity: float = STANDARD_GRAVITY, units: str = "m/s^2",
-                    holdout: tuple = (), pairwise_bias: bool = False, noise: dict | None = None) -> Calibration:
+                    holdout: tuple = (), pairwise_bias: bool = False, noise: dict | None = None,
+                    where: str = "positions") -> Calibration:
     """Accelerometer ``[M | b]`` from static positions of known orientation (reference section 5).
 
     Parameters
@@ -208,28 +238,45 @@ def calibrate_accel(means: dict, ups: dict, gravity: float = STANDARD_GRAVITY, u
         Replace the least-squares bias by the Ferraris pairwise bias (needs the six faces).
     noise : dict, optional
         Position name -> per-sample sigma (3,); accepted but not used yet.
+    where : str
+        The positions file (or ``"{sections}"``), for errors.
 
     Returns
     -------
     Calibration
         ``M`` (3, 3), ``bias`` (3,) SI, with residuals per fitted position and
         a check per held-out one.
+
+    Raises
+    ------
+    TestError, HandednessError
+        Readings that are not gravity in ``units`` (a unit mix-up), two orientations reading the
+        same, positions not spanning 3-D, an axis reading the wrong way (``det(M) <= 0``: a handedness
+        error naming the axis and its positions), a scale factor outside 1 +/- 0.2 (physical units).
     """
+    gravity = check_gravity(gravity)
+    check_at_rest(np.linalg.norm(np.reshape(list(means.values()), (-1, 3)), axis=1), gravity, units)
     fit_names = [k for k in means if k not in holdout]
     if len(fit_names) < 6:
         raise InputError(f"only {len(fit_names)} positions in the fit; the 12-parameter model needs at least 6 "
-                         "(the six faces +/-x, +/-y, +/-z up)", "positions")
+                         "(the six faces +/-x, +/-y, +/-z up)", where)
+    _check_distinct({k: means[k] for k in fit_names}, ups, where, units)
     obs = [_obs(k, means[k], np.ones(3), np.append(gravity * np.asarray(ups[k], float), 1.0)) for k in fit_names]
+    spans = "the positions do not span 3-D (every axis must point up and down at least once)"
     try:
         fit = fit_lsq(obs, equal_weights=True, method="ols")
     except TestError:
-        raise TestError("the positions do not span 3-D (every axis must point up and down at least once)", "positions") from None
+        raise TestError(spans, where) from None
     m, b = fit.M, fit.bias
+    if not np.all(np.isfinite(m)):
+        raise TestError(spans, where)
+    check_axes(m, {i: [k for k in fit_names if abs(ups[k][i]) > 0.7] for i in range(3)}, where)
+    check_scale_factors(m, 0.2, units, "acceleration", "units", where)
     notes = [f"local gravity {gravity:.6g} m/s^2" + (" (standard gravity)" if gravity == STANDARD_GRAVITY else "")]
     if pairwise_bias:
         missing = [f for f in FACES if f not in means]
         if missing:
-            raise InputError(f"the pairwise bias needs the six faces; missing {', '.join(missing)}", "positions")
+            raise InputError(f"the pairwise bias needs the six faces; missing {', '.join(missing)}", where)
         b = np.array([(means[f"{a}_p"][i] + means[f"{a}_a"][i]) / 2 for i, a in enumerate("xyz")])
         notes.append("bias: Ferraris pairwise (a_i(+i up) + a_i(-i up)) / 2, robust to a tilted reference surface")
     residuals = {k: means[k] - (m @ (gravity * np.asarray(ups[k])) + b) for k in fit_names}
@@ -268,6 +315,8 @@ def calibrate_accel_free(means: np.ndarray, gravity: float = STANDARD_GRAVITY, u
     from scipy.optimize import least_squares
 
     a = np.asarray(means, float)
+    gravity = check_gravity(gravity)
+    check_at_rest(np.linalg.norm(a, axis=1), gravity, units)
     k = len(a)
     if k < 9:
         raise InputError(f"only {k} static attitudes; the 9-parameter fit needs at least 9 (12 or more recommended)",
@@ -294,9 +343,13 @@ def calibrate_accel_free(means: np.ndarray, gravity: float = STANDARD_GRAVITY, u
 
     sol = least_squares(resid, x0, method="lm", x_scale="jac")
     u, b = unpack(sol.x)
+    # |U v| = |D U v| for D = diag(+/-1): the sign of each row of U is not observable; take the positive diagonal
+    # (each axis reads +g along itself), so a flipped axis cannot be seen here: only known orientations show it
+    u = np.diag(np.where(np.diag(u) < 0, -1.0, 1.0)) @ u
+    if not np.all(np.isfinite(u)) or np.linalg.cond(u) > 1e8:
+        raise TestError("the fit is degenerate (a singular matrix): turn the sensor through all directions",
+                        "static intervals")
     m = np.linalg.inv(u)
-    if np.linalg.det(m) <= 0:
-        raise TestError("the fit came out reflected (det < 0)", "static intervals")
     dof = max(k - 9, 1)
     s2 = float(np.sum(sol.fun**2)) / dof
     cov = np.linalg.pinv(sol.jac.T @ sol.jac) * s2

@@ -18,9 +18,12 @@ import numpy as np
 from align.alignment.job import AlignOptions, align
 from align.alignment.plan import Plan, Step
 from align.alignment.segment import Segment
-from align.calibration.accel import FACES, calibrate_accel, face_ups, static_means
+from align.calibration.accel import FACES, calibrate_accel, face_ups, norms_at_rest, static_means
 from align.calibration.results import Calibration
-from align.errors import InputError
+from align.errors import InputError, literal
+from align.io import check_finite
+from align.io.keys import check_keys
+from align.plausible import check_at_rest, check_gravity
 from align.units import STANDARD_GRAVITY
 
 #: imucal's section names: the six static faces, then the turns about x, y, z
@@ -28,12 +31,37 @@ SECTIONS = tuple(FACES) + ("x_rot", "y_rot", "z_rot")
 
 
 def _check_sections(sections: dict, n: int) -> None:
+    """Every section named, inside the log, and no two faces (or turns) sharing samples (a section copied)."""
+    check_keys(sections, SECTIONS, "{sections}")
     missing = [k for k in SECTIONS if k not in sections]
     if missing:
         raise InputError(f"missing sections {', '.join(missing)} (imucal's names: {', '.join(SECTIONS)})", "{sections}")
     for name, (a, b) in sections.items():
         if not 0 <= a < b <= n:
-            raise InputError(f"{a}..{b} is not inside the log's {n} samples", f"{{sections}}: {name}")
+            raise InputError(f"{literal(name)}: {a}..{b} is not inside the log's {n} samples", "{sections}")
+    # a face inside a turn is caught as "not static"; two faces (or two turns) sharing samples are a copied section
+    for group in (tuple(FACES), SECTIONS[len(FACES):]):
+        _check_disjoint(sections, group)
+
+
+def _check_disjoint(sections: dict, names: tuple[str, ...]) -> None:
+    for i, k in enumerate(names):
+        for other in names[i + 1:]:
+            (a, b), (c, d) = sections[k], sections[other]
+            if a < d and c < b:
+                same = "the same samples as" if (a, b) == (c, d) else "samples shared with"
+                raise InputError(f"{k} ({a}..{b}) has {same} {other} ({c}..{d}): each needs its own samples; "
+                                 "check the section list", "{sections}")
+
+
+def _readings(x: np.ndarray, sensor: str, columns: str, where: str) -> np.ndarray:
+    """Readings of one sensor as an (n, 3) float array, refusing another width and NaN rows (naming the log)."""
+    x = np.asarray(x, float)
+    if x.ndim != 2 or x.shape[1] != 3:
+        raise InputError(f"the {sensor} needs 3 columns (x, y, z), not {x.shape[-1] if x.ndim else 0}; "
+                         f"give three {{{columns}}}", where)
+    check_finite(x, where)
+    return x
 
 
 def _g_sensitivity(gyr: np.ndarray, sections: dict, gravity: float) -> np.ndarray:
@@ -44,7 +72,7 @@ def _g_sensitivity(gyr: np.ndarray, sections: dict, gravity: float) -> np.ndarra
 
 def ferraris(acc: np.ndarray, gyr: np.ndarray, fs: float, sections: dict, turn_angle: float,
              gravity: float = STANDARD_GRAVITY, acc_units: str = "m/s^2", gyr_units: str = "deg/s",
-             pairwise_bias: bool = True, g_sensitivity: bool = True) -> tuple[Calibration, Calibration]:
+             pairwise_bias: bool = True, g_sensitivity: bool = True, where: str = "log") -> tuple[Calibration, Calibration]:
     """A Ferraris session (six faces, one turn about each axis): accelerometer and gyro.
 
     Parameters
@@ -66,15 +94,27 @@ def ferraris(acc: np.ndarray, gyr: np.ndarray, fs: float, sections: dict, turn_a
         Accelerometer bias by Ferraris' pairwise formula (else least squares).
     g_sensitivity : bool
         Estimate and remove the gyro's ``K_ga`` from the static faces.
+    where : str
+        The log (its file name), for errors.
 
     Returns
     -------
     (Calibration, Calibration)
         The accelerometer and the gyroscope.
     """
+    gravity = check_gravity(gravity)
+    acc, gyr = _readings(acc, "accelerometer", "acc_columns", where), _readings(gyr, "gyroscope", "gyr_columns", where)
+    if len(acc) != len(gyr):
+        raise InputError(f"{len(acc)} accelerometer rows but {len(gyr)} gyro rows: one row per sample", where)
+    if not (np.isfinite(fs) and fs > 0):
+        raise InputError(f"the sample rate must be positive, not {fs:g} Hz", "{fs}")
+    if not (np.isfinite(turn_angle) and abs(turn_angle) > 0):
+        raise InputError("each turn needs a non-zero angle, e.g. '-360 deg'", "{turn_angle}")
     _check_sections(sections, len(acc))
-    means = static_means(acc, {f: sections[f] for f in FACES}, 0.05 * gravity / np.median(np.linalg.norm(acc, axis=1)))
-    acc_cal = calibrate_accel(means, face_ups(), gravity, acc_units, pairwise_bias=pairwise_bias)
+    at_rest = norms_at_rest(acc, {f: sections[f] for f in FACES})
+    check_at_rest(at_rest, gravity, acc_units, "acc_units")
+    means = static_means(acc, {f: sections[f] for f in FACES}, 0.05 * gravity / np.median(at_rest))
+    acc_cal = calibrate_accel(means, face_ups(), gravity, acc_units, pairwise_bias=pairwise_bias, where="{sections}")
     a_true = acc_cal.correct(acc)
     t = np.arange(len(acc)) / fs
     g = np.array(gyr, float)
@@ -99,8 +139,25 @@ def ferraris(acc: np.ndarray, gyr: np.ndarray, fs: float, sections: dict, turn_a
 
 
 def sections_from_dict(raw: dict, where: str = "sections") -> dict[str, tuple[int, int]]:
-    """imucal's section list (``{"x_p": {"start": i, "end": j}, ...}``) as sample ranges."""
-    try:
-        return {str(k): (int(v["start"]), int(v["end"])) for k, v in raw.items()}
-    except (KeyError, TypeError, ValueError, AttributeError):
-        raise InputError("each section needs integer start and end", where) from None
+    """imucal's section list (``{"x_p": {"start": i, "end": j}, ...}``) as sample ranges.
+
+    Raises
+    ------
+    InputError
+        Not an object, a section name that is not one of :data:`SECTIONS` or a key other than
+        ``start``/``end`` (the nearest valid one named), a start or end that is not a sample number.
+    """
+    if not isinstance(raw, dict):
+        raise InputError(f"expected a JSON object of sections ({', '.join(SECTIONS)})", where)
+    check_keys(raw, SECTIONS, where)
+    out = {}
+    for name, v in raw.items():
+        at = f"{where}: {name}"
+        if not isinstance(v, dict):
+            raise InputError(literal('each section needs integer start and end, e.g. {"start": 540, "end": 1271}'), at)
+        check_keys(v, ("start", "end"), at)
+        ends = [v.get("start"), v.get("end")]
+        if not all(isinstance(x, int) and not isinstance(x, bool) for x in ends):
+            raise InputError("each section needs integer start and end (samples, end exclusive)", at)
+        out[str(name)] = (ends[0], ends[1])
+    return out

@@ -29,13 +29,25 @@ from dataclasses import field as dataclass_field
 import numpy as np
 
 from align.calibration.ellipsoid import MODELS, algebraic_fit, pack, unpack
-from align.errors import InputError, TestError
+from align.errors import InputError, TestError, literal
 from align.io import check_finite
-from align.results import Result, file_unit
+from align.io.keys import check_keys
+from align.plausible import (
+    array_field,
+    check_dip,
+    check_field_strength,
+    check_known_field,
+    check_positive_definite,
+    malformed,
+)
+from align.results import Result, envelope, file_unit
 from align.units import DEG, to_unit
 
 FORMAT = "imu-align.magnetometer"
 CONVENTION = "m_cal = soft_iron (m_raw - hard_iron)"
+#: the keys of a magnetometer file after the envelope (unknown keys are refused: a misspelled key is not ignored)
+FILE_KEYS = ("sensor", "model", "hard_iron", "soft_iron", "field", "uncertainty", "quality", "notes", "misalignment",
+             "misalignment_convention", "inputs")
 
 
 class MagCalibration(Result, format=FORMAT, convention=CONVENTION):
@@ -94,8 +106,14 @@ class MagCalibration(Result, format=FORMAT, convention=CONVENTION):
         return "magnetometer"
 
     def correction(self, sensor: str | None = None, where: str = "magnetometer") -> MagCalibration:
-        """This calibration, which corrects magnetometer logs (see :class:`align.results.Correction`)."""
-        return self._only_sensor("magnetometer", sensor, where)
+        """This calibration, which corrects magnetometer logs (see :class:`align.results.Correction`).
+
+        Refuses (naming ``where``) a soft iron that is not finite, singular, ``det <= 0`` or not
+        positive definite (:func:`align.plausible.check_positive_definite`).
+        """
+        self._only_sensor("magnetometer", sensor, where, "soft_iron")
+        check_positive_definite(self.soft_iron, where)
+        return self
 
     def correct(self, raw: np.ndarray) -> np.ndarray:
         """``m_cal = W (raw - h)`` for readings of shape (n, 3), SI or counts."""
@@ -127,29 +145,32 @@ class MagCalibration(Result, format=FORMAT, convention=CONVENTION):
     def from_dict(cls, d: dict, where: str = "magnetometer") -> MagCalibration:
         """Read the form written by :meth:`to_dict` (any version up to the current one)."""
         cls.check_envelope(d, where)
+        check_keys(d, [*envelope(cls.FORMAT, cls.VERSION, cls.CONVENTION), *FILE_KEYS], where)
         try:
             u, f = file_unit(d, "hard_iron", None, where)
             q = d["quality"]
             mis = d.get("misalignment")
+            what = "magnetometer calibration"
+            hard, soft = array_field(d, "hard_iron", (3,), what, where, f), array_field(d, "soft_iron", (3, 3), what, where)
+            mis = None if mis is None else array_field(d, "misalignment", (3, 3), what, where)
             return cls(
-                hard_iron=np.array(d["hard_iron"], float).reshape(3) * f,
-                soft_iron=np.array(d["soft_iron"], float).reshape(3, 3),
+                hard_iron=hard, soft_iron=soft,
                 field=float(d["field"]) * f, model=d["model"], units=u,
                 sigma_hard_iron=np.array(d["uncertainty"]["hard_iron"], float).reshape(3) * f,
                 spread_before=q["field_spread_before"], spread_after=q["field_spread_after"], coverage=q["coverage"],
                 heading_error=q["predicted_heading_error_deg"] * DEG,
                 dip=None if q["dip_deg"] is None else q["dip_deg"] * DEG,
                 notes=tuple(d.get("notes", [])),
-                misalignment=None if mis is None else np.array(mis, float).reshape(3, 3),
+                misalignment=mis,
                 inputs=dict(d.get("inputs") or {}),
             )
         except (KeyError, TypeError, ValueError) as exc:
-            raise InputError(f"malformed magnetometer calibration ({exc!r})", where) from None
+            raise InputError(f"malformed magnetometer calibration ({malformed(exc)}); regenerate it", where) from None
 
 
 def calibrate_magnetometer(m: np.ndarray, units: str = "uT", field: float | None = None, model: str = "symmetric",
                            acc: np.ndarray | None = None, dip: float | None = None,
-                           max_hard_iron_sigma: float = 0.02) -> MagCalibration:
+                           max_hard_iron_sigma: float = 0.02, where: str = "magnetometer") -> MagCalibration:
     """Hard and soft iron from a tumbling capture (see module docstring).
 
     Parameters
@@ -167,6 +188,8 @@ def calibrate_magnetometer(m: np.ndarray, units: str = "uT", field: float | None
         Magnetic dip (rad) when no accelerometer is given; default 60 deg, said in the notes.
     max_hard_iron_sigma : float
         Refuse when the hard iron's 1-sigma exceeds this fraction of the field.
+    where : str
+        The capture (its file name), for errors.
 
     Returns
     -------
@@ -175,29 +198,48 @@ def calibrate_magnetometer(m: np.ndarray, units: str = "uT", field: float | None
     Raises
     ------
     TestError
-        The capture cannot give a trustworthy answer (planar, poor coverage, not an ellipsoid).
+        The capture cannot give a trustworthy answer (planar, poor coverage, not an ellipsoid), or its
+        field strength is not Earth's in ``units`` (a unit mix-up, named with its fix ``{units=gauss}``).
+    InputError
+        Not three columns, NaN rows, too few samples, a known ``field`` that is not Earth's,
+        a ``dip`` outside [-90, 90] deg.
     """
     from scipy.optimize import least_squares
 
     if model not in MODELS:
-        raise InputError(f"unknown model '{model}'; choose {', '.join(MODELS)}", "{model}")
+        raise InputError(f"unknown model '{literal(model)}'; choose {', '.join(MODELS)}", "{model}")
+    if dip is not None:
+        dip = check_dip(dip)
     m = np.asarray(m, float)
-    check_finite(m, "magnetometer")
+    if m.ndim != 2 or m.shape[1] != 3:
+        raise InputError(f"a magnetometer capture has 3 columns (x, y, z), not {m.shape[-1] if m.ndim else 0}; "
+                         "give three {columns}", where)
+    if acc is not None and np.shape(acc) != m.shape:
+        raise InputError(f"the accelerometer needs 3 columns and one row per magnetometer row, not {np.shape(acc)}; "
+                         "give three {accel_columns}", where)
+    check_finite(m, where)
     n_par = {"sphere": 4, "diagonal": 6, "symmetric": 9}[model]
     if len(m) < 3 * n_par:
-        raise InputError(f"only {len(m)} samples; the {model} model needs at least {3 * n_par}", "magnetometer")
+        raise InputError(f"only {len(m)} samples; the {model} model needs at least {3 * n_par}", where)
     # centre and scale (conditioning only; the hard iron comes from the fit, not from the sample mean)
     c0 = 0.5 * (m.min(axis=0) + m.max(axis=0))
     s0 = float(np.sqrt(np.mean(np.sum((m - c0) ** 2, axis=1))))
     if not s0 > 0:
-        raise TestError("all samples are equal: the sensor did not move", "magnetometer")
+        raise TestError("all samples are equal: the sensor did not move", where)
     x = (m - c0) / s0
     sv = np.linalg.svd(x - x.mean(axis=0), compute_uv=False)
     if sv[2] < 0.15 * sv[0]:
         raise TestError(f"planar or near-level capture: the samples barely leave a plane (thickness {sv[2] / sv[0]:.2f} of "
                         "their width); tilt the device through all orientations (a figure-eight in every direction)",
-                        "magnetometer")
-    centre, w = algebraic_fit(x, model)
+                        where)
+    try:
+        centre, w = algebraic_fit(x, model)
+    except TestError as exc:
+        raise TestError(exc.message, where) from None
+    strength = s0 / float(np.linalg.det(w)) ** (1 / 3)  # the readings' own field: the ellipsoid's mean radius
+    check_field_strength(strength, units, where=where)
+    if field is not None:
+        check_known_field(field, strength, units)
     target = None if field is None else field / s0
     p0 = np.concatenate([centre, pack(w, model)])
 
@@ -213,13 +255,13 @@ def calibrate_magnetometer(m: np.ndarray, units: str = "uT", field: float | None
     sol = least_squares(resid, p0, method="trf", bounds=(lo, hi), x_scale="jac")
     if np.any(np.isclose(sol.x[:3], lo[:3]) | np.isclose(sol.x[:3], hi[:3])):
         raise TestError("coverage too small: the fit runs away along the poorly covered direction (the geometric "
-                        "refinement reached its bound); rotate the device through more orientations", "magnetometer")
+                        "refinement reached its bound); rotate the device through more orientations", where)
     notes_refine = "geometric refinement (trust region) from the algebraic Li-Griffiths fit"
     centre, w = sol.x[:3], unpack(sol.x[3:], model)
     if target is None:  # the fitted field: scale W to unit determinant, |m_cal| is then the field
         det = np.linalg.det(w)
         if not det > 0:
-            raise TestError("the fit came out reflected or singular (det <= 0)", "magnetometer")
+            raise TestError("the fit came out reflected or singular (det <= 0)", where)
         scale = det ** (1 / 3)
         w = w / scale
         f_fit = 1.0 / scale
@@ -227,7 +269,7 @@ def calibrate_magnetometer(m: np.ndarray, units: str = "uT", field: float | None
         f_fit = target
     if not np.all(np.linalg.eigvalsh(w) > 0) or np.linalg.det(w) <= 0:
         raise TestError("the soft-iron matrix is not positive definite (a reflected or degenerate solution); "
-                        "the capture does not determine it", "magnetometer")
+                        "the capture does not determine it", where)
     dof = max(len(x) - len(sol.x), 1)
     r_final = resid(sol.x)
     cov = np.linalg.pinv(sol.jac.T @ sol.jac) * float(np.sum(r_final**2)) / dof
@@ -243,7 +285,7 @@ def calibrate_magnetometer(m: np.ndarray, units: str = "uT", field: float | None
         raise TestError(f"coverage too small: the hard iron is uncertain by {to_unit(np.max(sig_c), units):.3g} {units} "
                         f"(limit {100 * max_hard_iron_sigma:g} % of the field) and the calibrated directions cover "
                         f"{coverage:.3f} (0.333 for a full sphere); rotate the device through more orientations",
-                        "magnetometer")
+                        where)
     raw_norm = np.linalg.norm(m, axis=1)
     notes = [f"{model} model, {len(m)} samples; " + ("field fixed at the value given" if field is not None else
                                                       "field fitted (soft iron scaled to unit determinant)"), notes_refine]

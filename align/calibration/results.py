@@ -10,7 +10,7 @@ it also writes the pair as imucal's JSON (:meth:`CalibrationSet.as_imucal`).
 
 Public names
 ------------
-Calibration, CalibrationSet, SENSORS, FORMAT, CONVENTION
+Calibration, CalibrationSet, SENSORS, SENSOR_KEYS, FORMAT, CONVENTION
 """
 
 from __future__ import annotations
@@ -21,7 +21,9 @@ import numpy as np
 
 from align.errors import InputError
 from align.io.export import imucal_dict
-from align.results import Result, file_unit
+from align.io.keys import check_keys
+from align.plausible import array_field, check_usable_model, malformed
+from align.results import Result, envelope, file_unit
 from align.units import to_unit
 from align.values import Value, frozen_array
 
@@ -29,6 +31,9 @@ FORMAT = "imu-align.calibration"
 CONVENTION = "raw = M true + bias; true = M^-1 (raw - bias); rows of M are sensor axes"
 #: the sensors a calibration file may hold, in the order they are written
 SENSORS = ("accelerometer", "gyroscope")
+#: the keys of one sensor's calibration in the file (unknown keys are refused: a misspelled key is not ignored)
+SENSOR_KEYS = ("sensor", "method", "convention", "units", "M", "A", "bias", "uncertainty", "residuals", "checks", "notes",
+               "g_sensitivity")
 
 
 @dataclass(frozen=True, eq=False)
@@ -95,23 +100,27 @@ class Calibration(Value):
     @classmethod
     def from_dict(cls, d: dict, where: str = "calibration") -> Calibration:
         """Read the form written by :meth:`to_dict`."""
+        if not isinstance(d, dict):
+            raise InputError("malformed calibration: expected a JSON object", where)
+        check_keys(d, SENSOR_KEYS, where)
         try:
             u, f = file_unit(d, "bias", None, where)
             unc = d.get("uncertainty", {})
             gs = d.get("g_sensitivity")
+            m, bias = array_field(d, "M", (3, 3), "calibration", where), array_field(d, "bias", (3,), "calibration", where, f)
+            kga = None if gs is None else array_field(d, "g_sensitivity", (3, 3), "calibration", where, f)
             return cls(
-                sensor=d["sensor"], M=np.array(d["M"], float).reshape(3, 3),
-                bias=np.array(d["bias"], float).reshape(3) * f,
+                sensor=d["sensor"], M=m, bias=bias,
                 sigma_M=np.array(unc.get("M", np.full((3, 3), np.nan)), float).reshape(3, 3),
                 sigma_bias=np.array(unc.get("bias", [np.nan] * 3), float).reshape(3) * f,
                 units=u, method=d.get("method", ""),
                 residuals={k: np.array(v, float) * f for k, v in d.get("residuals", {}).items()},
                 checks={k: np.array(v, float) * f for k, v in d.get("checks", {}).items()},
                 notes=tuple(d.get("notes", [])),
-                g_sensitivity=None if gs is None else np.array(gs, float).reshape(3, 3) * f,
+                g_sensitivity=kga,
             )
         except (KeyError, TypeError, ValueError) as exc:
-            raise InputError(f"malformed calibration ({exc!r})", where) from None
+            raise InputError(f"malformed calibration ({malformed(exc)}); regenerate it", where) from None
 
     def correct(self, raw: np.ndarray, acc: np.ndarray | None = None) -> np.ndarray:
         """``true = M^-1 (raw - bias - K_ga acc)``.
@@ -162,6 +171,7 @@ class CalibrationSet(Result, format=FORMAT, convention=CONVENTION):
     def from_dict(cls, d: dict, where: str = "calibration") -> CalibrationSet:
         """Read the form written by :meth:`to_dict` (any version up to the current one)."""
         cls.check_envelope(d, where)
+        check_keys(d, [*envelope(cls.FORMAT, cls.VERSION, cls.CONVENTION), "inputs", *SENSORS], where)
         sensors = {k: Calibration.from_dict(d[k], f"{where}: {k}") for k in SENSORS if k in d}
         if not sensors:
             raise InputError(f"holds no {' or '.join(SENSORS)} calibration", where)
@@ -188,8 +198,14 @@ class CalibrationSet(Result, format=FORMAT, convention=CONVENTION):
         return self.sensors[kind]
 
     def correction(self, sensor: str | None = None, where: str = "calibration") -> Calibration:
-        """The calibration that corrects logs of ``sensor`` (see :meth:`sensor`)."""
-        return self.sensor(sensor, where)
+        """The calibration that corrects logs of ``sensor`` (see :meth:`sensor`).
+
+        Refuses (naming ``where`` and the sensor) an ``M`` that is not finite, singular or has
+        ``det <= 0`` (:func:`align.plausible.check_usable_model`).
+        """
+        cal = self.sensor(sensor, where)
+        check_usable_model(cal.M, f"{where}: {cal.sensor}")
+        return cal
 
     def as_imucal(self) -> dict:
         """The pair as imucal's ``FerrarisCalibrationInfo`` JSON (see :func:`align.io.export.imucal_dict`)."""

@@ -1,20 +1,26 @@
 """The ``imu-align`` command line: a thin layer over the library.
 
-Each command parses its options (units at this edge), checks its output paths,
-calls the library, prints a summary and writes its files only after everything
-succeeded. Every failure is one line on stderr and an exit status:
+Each command parses its options (units and domains at this edge), checks its
+output paths, calls the library, and stages its files as it computes them; they
+are committed together at its end, so a failed run writes nothing (all or none,
+:class:`align.io.outputs.Outputs`). Every failure is one line on stderr and an
+exit status:
 
 * a usage mistake (unknown command or option, missing argument, a value of the
-  wrong type): ``imu-align CMD: what is wrong; usage: ...; see imu-align CMD --help``, status 2;
+  wrong type or outside its domain): ``imu-align CMD: what is wrong; usage: ...;
+  see imu-align CMD --help``, status 2;
 * a library error: ``imu-align: error: `` + the error with its inputs spelled as
-  flags (:func:`align.cli.options.spell`), status 2 (input), 3 (test) or 4 (check);
+  the command's own flags, or in words for an input the command has no option
+  for (:func:`align.cli.options.spell`), status 2 (input), 3 (test) or 4 (check);
+* Ctrl-C: ``imu-align: interrupted; nothing was written``, status 130; a closed
+  pipe (``| head``): quiet, status 1;
 * anything else: ``imu-align: internal error: ...``, status 1 (``IMU_ALIGN_DEBUG=1``
-  shows the traceback).
+  shows the traceback, and the warnings that are otherwise never shown).
 
 Modules
 -------
-options    shared option types, the field -> flag table, old spellings
-paths      output checks before the work, JSON writing
+options    shared option types and their domains, the field -> flag table, old spellings
+paths      output checks before the work, the run's all-or-none outputs
 progress   the progress bar of long jobs
 alignment  matrix, apply, simulate
 mechanics  budget, allowable, check
@@ -163,40 +169,100 @@ def _usage_message(exc: Exception, path: list[str], args: list[str]) -> str:
 
 def _fail(path: list[str], what: str) -> int:
     where = " ".join([PROG, *path])
-    typer.echo(f"{where}: {what}; {_usage(path)}; see {where} --help", err=True)
+    _say(f"{where}: {what}; {_usage(path)}; see {where} --help")
     return 2
 
 
+def _known(path: list[str]) -> frozenset[str] | None:
+    """The options (``--json``, ``--no-earth``) and argument names (``LOG``) of the command at ``path``."""
+    if not path:
+        return None
+    known: set[str] = set()
+    for p in _params(path):
+        if getattr(p, "param_type_name", "") == "argument":
+            known.add(_flag(p))
+        else:
+            known.update(getattr(p, "opts", []) + getattr(p, "secondary_opts", []))
+    return frozenset(known)
+
+
+def _internal(exc: BaseException) -> str:
+    """One line for an unexpected exception: its type and its first 300 characters."""
+    text = " ".join(f"{type(exc).__name__}: {exc}".split())
+    return text if len(text) <= 300 else text[:297] + "..."
+
+
+def _quiet_pipe() -> int:
+    """stdout's reader went away (``| head``): point stdout at /dev/null so that exiting flushes nothing."""
+    try:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
+    return 1
+
+
 def run(args: list[str]) -> int:
-    """Run ``imu-align ARGS`` and return the exit status; every failure is one line on stderr."""
+    """Run ``imu-align ARGS`` and return the exit status; every failure is one line on stderr.
+
+    Warnings (numpy's ``invalid value encountered``, ...) never reach the terminal: a result
+    that cannot be trusted is refused by the library's checks instead; ``IMU_ALIGN_DEBUG=1``
+    shows them (and the traceback of an unexpected error).
+    """
+    import warnings
+
+    debug = bool(os.environ.get("IMU_ALIGN_DEBUG"))
+    try:
+        with warnings.catch_warnings():
+            if not debug:
+                warnings.simplefilter("ignore")
+            return _run(args, debug)
+    except KeyboardInterrupt:
+        _say(f"{PROG}: interrupted; nothing was written")
+        return 130
+    except BrokenPipeError:
+        return _quiet_pipe()
+
+
+def _say(line: str) -> None:
+    try:
+        typer.echo(line, err=True)
+    except (OSError, ValueError):
+        pass
+
+
+def _run(args: list[str], debug: bool) -> int:
     from align.errors import AlignError
 
     path, problem = _command_path(args)
     if problem:
         return _fail(path, problem)
     command = " ".join(path) or None
+    args = rewrite_aliases(command, args)
     try:
-        code = app(args=rewrite_aliases(command, args), prog_name=PROG, standalone_mode=False)
+        code = app(args=args, prog_name=PROG, standalone_mode=False)
     except AlignError as exc:
-        typer.echo(f"{PROG}: error: {exc.render(speller(command))}", err=True)
+        _say(f"{PROG}: error: {' '.join(exc.render(speller(command, _known(path))).split())}")  # one line, always
         return exc.exit_code
     except BrokenPipeError:
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 1
+        return _quiet_pipe()
     except Exception as exc:
         if hasattr(exc, "exit_code") and hasattr(exc, "format_message"):  # a usage error (click's or typer's)
             if getattr(exc, "exit_code", 2) != 2:
-                typer.echo(f"{PROG}: error: {' '.join(exc.format_message().split())}", err=True)
+                _say(f"{PROG}: error: {' '.join(exc.format_message().split())}")
                 return exc.exit_code
             return _fail(path, " ".join(_usage_message(exc, path, args).split()))
-        if isinstance(exc, typer.Abort):
-            typer.echo(f"{PROG}: aborted", err=True)
+        if isinstance(exc, typer.Abort):  # click's answer to Ctrl-C
+            _say(f"{PROG}: interrupted; nothing was written")
             return 130
-        if os.environ.get("IMU_ALIGN_DEBUG"):
+        if debug:
             raise
-        message = " ".join(f"{type(exc).__name__}: {exc}".split())
-        typer.echo(f"{PROG}: internal error: {message} (set IMU_ALIGN_DEBUG=1 for details)", err=True)
+        if isinstance(exc, MemoryError):
+            _say(f"{PROG}: error: out of memory; use a smaller input (or, for allan, a lower --memory-limit-mb)")
+            return 1
+        _say(f"{PROG}: internal error: {_internal(exc)} (set IMU_ALIGN_DEBUG=1 for details)")
         return 1
+    if code == 130:  # typer's answer to Ctrl-C (KeyboardInterrupt inside a command), said in no words
+        _say(f"{PROG}: interrupted; nothing was written")
     return code if isinstance(code, int) else 0
 
 

@@ -9,8 +9,8 @@ matrix, apply, simulate, COMMANDS
 import typer
 
 from align.cli import options as opt
-from align.cli.options import split_columns, value
-from align.cli.paths import check_outputs, save_json
+from align.cli.options import DURATION, NONNEGATIVE, NONZERO, PAUSE, POSITIVE, TOLERANCE, split_columns, value
+from align.cli.paths import check_outputs, outputs
 
 GYRO_COLUMNS = "time,gyro_x,gyro_y,gyro_z"
 #: the columns ``apply`` reads by default, per sensor
@@ -33,18 +33,21 @@ def matrix(
     json_out: opt.JsonOut = None,
     c_header: opt.OptInput("--c-header", "Write A and the bias as a C header here.", "FILE.h") = None,
     gyro_range: opt.OptQuantity("--gyro-range", "angular_rate", "Gyro full scale, e.g. '2000 deg/s': flags saturation.",
-                            "RATE") = None,
-    min_dwell: opt.Quantity("--min-dwell", "time", "Shortest acceptable step.", "TIME") = "1 s",
-    window: opt.Quantity("--window", "time", "Moving-mean window of the segmentation.", "TIME") = "0.1 s",
-    margin: opt.Quantity("--margin", "time", "Trimmed from each end of a dwell beyond the ramp.", "TIME") = "0.1 s",
+                            "RATE", POSITIVE, "'2000 deg/s'") = None,
+    min_dwell: opt.Quantity("--min-dwell", "time", "Shortest acceptable step.", "TIME", DURATION, "'1 s'") = "1 s",
+    window: opt.Quantity("--window", "time", "Moving-mean window of the segmentation.", "TIME", DURATION,
+                         "'0.1 s'") = "0.1 s",
+    margin: opt.Quantity("--margin", "time", "Trimmed from each end of a dwell beyond the ramp.", "TIME", PAUSE,
+                         "'0.1 s'") = "0.1 s",
     static_threshold: opt.Quantity("--static-threshold", "angular_rate",
-                               "Static periods lie within this of the quietest one (angle plans).", "RATE") = "1 deg/s",
+                               "Static periods lie within this of the quietest one (angle plans).", "RATE", POSITIVE,
+                                   "'1 deg/s'") = "1 deg/s",
     rate_tolerance: opt.Quantity("--rate-tolerance", "dimensionless", "Largest difference of a measured turn from the plan.",
-                             "RATIO") = "10 %",
+                             "RATIO", TOLERANCE, "'10 %'") = "10 %",
     scale_tolerance: opt.Quantity("--scale-tolerance", "dimensionless", "Scale factors must lie within 1 +/- this.",
-                              "RATIO") = "5 %",
+                              "RATIO", TOLERANCE, "'5 %'") = "5 %",
     axis_to_axis: opt.Quantity("--axis-to-axis", "angle", "Axis-to-axis spec for the two-axis shortcut's error.",
-                           "ANGLE") = "0.05 deg",
+                           "ANGLE", POSITIVE, "'0.05 deg'") = "0.05 deg",
     two_axis_variant: opt.Choice("--two-axis-variant", ("procrustes", "cross"),
                              "Two-axis shortcut: procrustes, or cross (the source's Eq 36).") = "procrustes",
     earth: opt.Flag("--earth/--no-earth", "Correct the vertical Earth rate when the plan gives a latitude.") = True,
@@ -68,11 +71,12 @@ def matrix(
     result = align(t, g, the_plan, opts, segs, gyro_units, str(log))
     result = result.replace(inputs={"log": str(log), "plan": str(plan), "gyro_units": gyro_units, "columns": columns,
                                     "segments": None if segments is None else str(segments)})
+    with outputs() as out:  # all or none
+        if json_out is not None:
+            out.write_json(json_out, result)
+        if c_header is not None:
+            out.write_text(c_header, result.as_c_header(f"imu-align alignment from {log.name}"))
     typer.echo(alignment_summary(result))
-    if json_out is not None:
-        save_json(json_out, result)
-    if c_header is not None:
-        fileio.write_text(c_header, result.as_c_header(f"imu-align alignment from {log.name}"))
 
 
 def apply(
@@ -80,7 +84,8 @@ def apply(
     alignment: opt.Input("--alignment", "A result of 'matrix', 'calibrate ferraris', 'calibrate accel' or 'calibrate mag'.",
                      "RESULT.json"),
     out: opt.Input("--out", "Corrected CSV (same columns and units).", "OUT.csv"),
-    sensor: opt.Choice("--sensor", ("accelerometer", "gyroscope"), "The sensor to correct, for a file holding both.") = None,
+    sensor: opt.Choice("--sensor", ("accelerometer", "gyroscope", "magnetometer"),
+                       "The sensor to correct, for a file holding several.") = None,
     gyro_units: opt.GyroUnits() = "deg/s",
     units: opt.Units("Unit of the columns for an accelerometer or magnetometer result (default: the result's).") = None,
     columns: opt.Columns("Column names: time,x,y,z (x,y,z with --rate-hz); default per sensor.", optional=True) = None,
@@ -91,23 +96,35 @@ def apply(
     import numpy as np
 
     import align.io as fileio
+    from align.errors import AlignError, UnitError, literal
+    from align.plausible import check_corrected
     from align.results import load_result
     from align.units import parse_unit, to_unit
 
     correction = load_result(alignment).correction(value(sensor), str(alignment))
     kind = correction.sensor
     if units:
-        u, where = units, "{units}"
+        u, field = units, "units"
     elif kind == "gyroscope":
-        u, where = gyro_units, "{gyro_units}"
+        u, field = gyro_units, "gyro_units"
     else:
-        u, where = correction.units, f"{alignment}: units"
+        u, field = correction.units, "units"
     expect = "angular_rate" if kind == "gyroscope" else None
-    parse_unit(u, expect, where)
+    unit = parse_unit(u, expect, "{" + field + "}" if units or kind == "gyroscope" else f"{alignment}: units")
+    try:
+        own = parse_unit(correction.units).dim
+    except AlignError:  # the size of one count ('0.92 mG'): any unit of the log is the user's to state
+        own = unit.dim
+    if kind != "gyroscope" and unit.dim != own:
+        raise UnitError(f"'{literal(u)}' is not a unit of the {kind} data of {alignment} ({literal(correction.units)}); "
+                        f"give the log's unit, e.g. {{units={correction.units}}}", "{units}")
     time_col, cols = split_columns(columns or SENSOR_COLUMNS[kind], rate_hz)
     t, raw = fileio.read_log(log, cols, u, time_col, rate_hz, expect=expect)
+    corrected = correction.correct(raw)
+    check_corrected(kind, corrected, u, field, str(log))  # a log read in the wrong unit is refused
     names = ([time_col] if time_col else []) + cols
-    fileio.write_csv(out, names, np.column_stack(([t] if time_col else []) + [to_unit(correction.correct(raw), u)]))
+    with outputs() as staged:
+        staged.write_csv(out, names, np.column_stack(([t] if time_col else []) + [to_unit(corrected, u)]))
     typer.echo(f"wrote {out}: {len(t)} rows of {kind} data corrected with {alignment} ({u})")
 
 
@@ -115,14 +132,18 @@ def simulate(
     out_dir: opt.Arg("Folder for session.csv, plan.toml and truth.json (created if missing).", "OUT_DIR"),
     plan: opt.OptInput("--plan", "Plan to run ([[step]] tables); default the six-dwell +/- rate plan.", "PLAN.toml") = None,
     kind: opt.Choice("--kind", ("rate", "angle"), "The default plan's kind.") = "rate",
-    rate: opt.Quantity("--rate", "angular_rate", "Table rate of the default rate plan.", "RATE") = "100 deg/s",
-    angle: opt.Quantity("--angle", "angle", "Turn of the default angle plan.", "ANGLE") = "360 deg",
+    rate: opt.Quantity("--rate", "angular_rate", "Table rate of the default rate plan.", "RATE", POSITIVE,
+                       "'100 deg/s'") = "100 deg/s",
+    angle: opt.Quantity("--angle", "angle", "Turn of the default angle plan.", "ANGLE", NONZERO, "'360 deg'") = "360 deg",
     rate_hz: opt.RateHz("Sample rate.") = "200 Hz",
-    dwell: opt.Quantity("--dwell", "time", "Constant-rate part of each rate step.", "TIME") = "10 s",
-    gap: opt.Quantity("--gap", "time", "Static gap between steps.", "TIME") = "3 s",
-    noise: opt.Quantity("--noise", "angle_random_walk", "Angle random walk (white rate noise).", "ARW") = "0.3 deg/sqrt(h)",
-    bias_walk: opt.Quantity("--bias-walk", "rate_random_walk", "Rate random walk of the bias.", "RRW") = "0 deg/h/sqrt(h)",
-    misalignment: opt.Quantity("--misalignment", "angle", "Size of the random mounting rotation.", "ANGLE") = "0.5 deg",
+    dwell: opt.Quantity("--dwell", "time", "Constant-rate part of each rate step.", "TIME", DURATION, "'10 s'") = "10 s",
+    gap: opt.Quantity("--gap", "time", "Static gap between steps.", "TIME", PAUSE, "'3 s'") = "3 s",
+    noise: opt.Quantity("--noise", "angle_random_walk", "Angle random walk (white rate noise).", "ARW", NONNEGATIVE,
+                        "'0.3 deg/sqrt(h)'") = "0.3 deg/sqrt(h)",
+    bias_walk: opt.Quantity("--bias-walk", "rate_random_walk", "Rate random walk of the bias.", "RRW", NONNEGATIVE,
+                            "'3 deg/h/sqrt(h)'") = "0 deg/h/sqrt(h)",
+    misalignment: opt.Quantity("--misalignment", "angle", "Size of the random mounting rotation.", "ANGLE", NONNEGATIVE,
+                               "'0.5 deg'") = "0.5 deg",
     seed: opt.Seed = 0,
     gyro_units: opt.GyroUnits("Unit of the written gyro columns.") = "deg/s",
 ) -> None:
@@ -134,8 +155,9 @@ def simulate(
     import align.io as fileio
     from align.alignment.plan import Plan
     from align.alignment.simulate import SessionSpec, SimulationTruth, random_model, simulate_session
-    from align.units import to_unit
+    from align.units import parse_unit, to_unit
 
+    parse_unit(gyro_units, "angular_rate", "{gyro_units}")
     if plan is not None:
         the_plan = Plan.from_dict(fileio.read_toml(plan), str(plan))
     else:
@@ -144,9 +166,11 @@ def simulate(
     truth = random_model(rng, misalignment)
     spec = SessionSpec(fs=rate_hz, dwell_s=dwell, static_s=gap, noise_density=noise, bias_walk=bias_walk)
     t, g, _ = simulate_session(the_plan, truth, spec, rng)
-    fileio.write_csv(out_dir / names[0], GYRO_COLUMNS.split(","), np.column_stack([t, to_unit(g, gyro_units)]))
-    fileio.write_text(out_dir / names[1], the_plan.to_toml())
-    save_json(out_dir / names[2], SimulationTruth(truth, gyro_units, seed))
+    with outputs() as out:  # all or none (a folder it creates is removed again on a failure)
+        out.folder(out_dir)
+        out.write_csv(out_dir / names[0], GYRO_COLUMNS.split(","), np.column_stack([t, to_unit(g, gyro_units)]))
+        out.write_text(out_dir / names[1], the_plan.to_toml())
+        out.write_json(out_dir / names[2], SimulationTruth(truth, gyro_units, seed))
     typer.echo(f"wrote {out_dir}/session.csv ({len(t)} rows, {t[-1]:.1f} s), plan.toml and truth.json")
 
 

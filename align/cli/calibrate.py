@@ -10,8 +10,8 @@ from typing import Annotated
 import typer
 
 from align.cli import options as opt
-from align.cli.options import names, split_columns, value
-from align.cli.paths import check_outputs, save_json
+from align.cli.options import DIP, DURATION, NONZERO, POSITIVE, names, split_columns, value
+from align.cli.paths import check_outputs, outputs
 
 Gravity = "Local gravity"
 
@@ -21,8 +21,8 @@ def ferraris(
     sections: opt.Input("--sections", "imucal section list JSON: x_p ... z_a, x_rot, y_rot, z_rot.", "SECTIONS.json"),
     rate_hz: opt.RateHz("Sample rate.", required=True),
     turn_angle: opt.Quantity("--turn-angle", "angle", "Signed angle of each turn about the axis pointing up.",
-                         "ANGLE") = "-360 deg",
-    gravity: opt.Quantity("--gravity", "acceleration", Gravity + ".", "ACCEL") = "9.80665 m/s^2",
+                         "ANGLE", NONZERO, "'-360 deg'") = "-360 deg",
+    gravity: opt.Quantity("--gravity", "acceleration", Gravity + ".", "ACCEL", POSITIVE, "'9.81 m/s^2'") = "9.80665 m/s^2",
     accel_columns: opt.Columns("Accelerometer columns.", "--accel-columns") = "acc_x,acc_y,acc_z",
     gyro_columns: opt.Columns("Gyro columns.", "--gyro-columns") = "gyr_x,gyr_y,gyr_z",
     accel_units: opt.UnitFlag("--accel-units", "Accelerometer unit.") = "m/s^2",
@@ -44,14 +44,15 @@ def ferraris(
     _, gyr = fileio.read_log(log, names(gyro_columns), gyro_units, None, rate_hz)
     ranges = sections_from_dict(fileio.read_json(sections), str(sections))
     acc_cal, gyr_cal = compute(acc, gyr, rate_hz, ranges, turn_angle, gravity, accel_units, gyro_units,
-                               pairwise_bias=value(bias) == "pairwise", g_sensitivity=g_sensitivity)
+                               pairwise_bias=value(bias) == "pairwise", g_sensitivity=g_sensitivity, where=str(log))
     result = CalibrationSet({"accelerometer": acc_cal, "gyroscope": gyr_cal},
                             {"log": str(log), "sections": str(sections)})
+    with outputs() as out:  # all or none
+        if json_out is not None:
+            out.write_json(json_out, result)
+        if imucal_json is not None:
+            out.write_json(imucal_json, result.as_imucal())
     typer.echo(calibration_summary(result.sensors))
-    if json_out is not None:
-        save_json(json_out, result)
-    if imucal_json is not None:
-        fileio.write_json(imucal_json, result.as_imucal())
 
 
 def accel(
@@ -61,13 +62,14 @@ def accel(
     columns: opt.Columns("Columns: time,x,y,z (x,y,z with --rate-hz).") = "time,acc_x,acc_y,acc_z",
     rate_hz: opt.RateHz() = None,
     accel_units: opt.UnitFlag("--accel-units", "Unit of the readings (an acceleration, or 'counts').") = "m/s^2",
-    gravity: Annotated[str | None, typer.Option("--gravity", metavar="ACCEL", help=(
-        Gravity + " (default 9.80665 m/s^2, or the positions file's gravity)."))] = None,
-    window: opt.Quantity("--window", "time", "Variance window of the static detector.", "TIME") = "1 s",
-    factor: Annotated[float, typer.Option("--factor", help="Static threshold: this many times the quiet variance.")] = 6.0,
+    gravity: opt.Text("--gravity", "acceleration", Gravity + " (default 9.80665 m/s^2, or the positions file's gravity).",
+                      "ACCEL", POSITIVE, "'9.81 m/s^2'") = None,
+    window: opt.Quantity("--window", "time", "Variance window of the static detector.", "TIME", DURATION, "'1 s'") = "1 s",
+    factor: opt.Number("--factor", "Static threshold: this many times the quiet variance (> 0).", POSITIVE, "6",
+                       "FACTOR") = 6.0,
     init_static: opt.OptQuantity("--init-static", "time", "Initial static period for the threshold (imu_tk), e.g. '50 s'.",
-                             "TIME") = None,
-    min_static: opt.Quantity("--min-static", "time", "Shortest static interval.", "TIME") = "1 s",
+                             "TIME", DURATION, "'50 s'") = None,
+    min_static: opt.Quantity("--min-static", "time", "Shortest static interval.", "TIME", DURATION, "'1 s'") = "1 s",
     json_out: opt.JsonOut = None,
 ) -> None:
     """Accelerometer multi-position calibration (known orientations, or |a| = g over many attitudes)."""
@@ -86,9 +88,10 @@ def accel(
                               str(positions))
     result = CalibrationSet({"accelerometer": cal}, {"log": str(log),
                                                      "positions": None if positions is None else str(positions)})
+    with outputs() as out:
+        if json_out is not None:
+            out.write_json(json_out, result)
     typer.echo(calibration_summary(result.sensors))
-    if json_out is not None:
-        save_json(json_out, result)
 
 
 def mag(
@@ -101,29 +104,35 @@ def mag(
     model: opt.Choice("--model", ("sphere", "diagonal", "symmetric"), "Soft-iron model.") = "symmetric",
     accel_columns: opt.Columns("Simultaneous accelerometer columns (dip angle, alignment to gravity).", "--accel-columns",
                            optional=True) = None,
-    dip: opt.OptQuantity("--dip", "angle", "Magnetic dip for the heading-error prediction when no accelerometer.",
-                     "ANGLE") = None,
+    dip: opt.OptQuantity("--dip", "angle", "Magnetic dip for the heading-error prediction when no accelerometer "
+                         "(-90 to 90 deg).", "ANGLE", DIP, "'60 deg'") = None,
     json_out: opt.JsonOut = None,
 ) -> None:
     """Magnetometer hard and soft iron (ellipsoid fit with coverage gates)."""
     check_outputs([log], json_out=json_out)
     import align.io as fileio
     from align.calibration import calibrate_magnetometer, with_gravity_alignment
+    from align.errors import InputError
+    from align.io.logs import check_readings
     from align.present.text import magnetometer_summary
     from align.units import parse_quantity, parse_scale
 
     scale, shown = parse_scale(mag_units, "magnetic_field", "{mag_units}")
     _, data = fileio.read_columns(log, names(columns) + (names(accel_columns) if accel_columns else []))
+    check_readings(data, str(log))
     m = data[:, :3] * scale
     acc = data[:, 3:6] if accel_columns else None
     f = None if field is None else parse_quantity(field, "counts" if shown == "counts" else "magnetic_field", "{field}")
-    cal = calibrate_magnetometer(m, shown, f, value(model), acc, dip)
+    if f is not None and not f > 0:
+        raise InputError("give a field strength > 0, e.g. '48.5 uT'", "{field}")
+    cal = calibrate_magnetometer(m, shown, f, value(model), acc, dip, where=str(log))
     if acc is not None:
         cal = with_gravity_alignment(cal, m, acc)
     cal = cal.replace(inputs={"log": str(log), "columns": columns, "mag_units": mag_units})
+    with outputs() as out:
+        if json_out is not None:
+            out.write_json(json_out, cal)
     typer.echo(magnetometer_summary(cal))
-    if json_out is not None:
-        save_json(json_out, cal)
 
 
 COMMANDS = {"ferraris": ferraris, "accel": accel, "mag": mag}

@@ -6,13 +6,12 @@ budget, allowable, check, COMMANDS, MOUNT_HELP, MANOEUVRE_HELP
 """
 
 from pathlib import Path
-from typing import Annotated
 
 import typer
 
 from align.cli import options as opt
 from align.cli.options import value
-from align.cli.paths import check_outputs, save_json
+from align.cli.paths import check_outputs, data_files, outputs
 from align.cli.progress import progress
 
 MOUNT_HELP = "Mount description TOML: [imu], [package], [ledges] or [baseplate], [screws]."
@@ -43,16 +42,16 @@ def budget(
     plot: opt.OptInput("--plot", "PNG histogram of the Monte Carlo (needs --monte-carlo).", "FILE.png") = None,
     picture: opt.OptInput("--picture", "PNG of the assembly, tilt exaggerated.", "FILE.png") = None,
     glb: opt.OptInput("--glb", "GLB of the assembly, tilt exaggerated.", "FILE.glb") = None,
-    exaggerate: Annotated[float, typer.Option("--exaggerate", help="Angle exaggeration of --picture and --glb.")] = 30.0,
+    exaggerate: opt.Number("--exaggerate", "Angle exaggeration of --picture and --glb (> 0, at most 10000).",
+                           opt.Domain("> 0 and <= 10000", low=0.0, high=1e4), "30", "FACTOR") = 30.0,
 ) -> None:
     """Mounting-misalignment budget: source formulas, worst case and Monte Carlo."""
     from align.errors import InputError
 
     if plot is not None and monte_carlo == 0:
         raise InputError("the histogram needs {monte_carlo}", "{plot}")
-    check_outputs([mount], json_out=json_out, plot=plot, picture=picture, glb=glb)
+    check_outputs([mount, *data_files(mount=mount)], json_out=json_out, plot=plot, picture=picture, glb=glb)
     import mechanics
-    from align.io import write_bytes
     from align.present.text import budget_summary
 
     m = _read_mount(mount)
@@ -60,18 +59,16 @@ def budget(
     if monte_carlo:
         with progress(monte_carlo, "Monte Carlo") as tick:
             result = result.replace(monte_carlo=mechanics.monte_carlo(m, monte_carlo, seed, progress=tick))
-    pictures = []  # drawn before anything is written
-    if plot is not None:
-        pictures.append((plot, mechanics.histogram_png(result)))
-    if picture is not None:
-        pictures.append((picture, mechanics.assembly_png(m, exaggerate)))
-    if glb is not None:
-        pictures.append((glb, mechanics.assembly_glb(m, exaggerate)))
+    with outputs() as out:  # all or none: every picture is drawn before anything is written
+        if plot is not None:
+            out.write_bytes(plot, mechanics.histogram_png(result))
+        if picture is not None:
+            out.write_bytes(picture, mechanics.assembly_png(m, exaggerate))
+        if glb is not None:
+            out.write_bytes(glb, mechanics.assembly_glb(m, exaggerate))
+        if json_out is not None:
+            out.write_json(json_out, result)
     typer.echo(budget_summary(result))
-    if json_out is not None:
-        save_json(json_out, result)
-    for path, data in pictures:
-        write_bytes(path, data)
 
 
 def allowable(
@@ -80,7 +77,7 @@ def allowable(
     symbolic: opt.Choice("--symbolic", ("pretty", "latex"), "Also print the sympy response and sensitivity.") = None,
 ) -> None:
     """Allowable misalignment per element for a manoeuvre, the binding element and the cone."""
-    check_outputs([manoeuvre], json_out=json_out)
+    check_outputs([manoeuvre, *data_files(manoeuvre=manoeuvre)], json_out=json_out)
     from align.present.text import allowable_summary
     from align.sensitivity import allowable as compute
     from align.sensitivity import symbolic_text
@@ -89,9 +86,10 @@ def allowable(
     if symbolic is not None:
         typer.echo(symbolic_text(value(symbolic)) + "\n")
     result = compute(man)
+    with outputs() as out:
+        if json_out is not None:
+            out.write_json(json_out, result)
     typer.echo(allowable_summary(result))
-    if json_out is not None:
-        save_json(json_out, result)
 
 
 def check(
@@ -101,7 +99,7 @@ def check(
     json_out: opt.JsonOut = None,
 ) -> None:
     """The mounting budget against the allowance; exit status 4 when an element fails."""
-    check_outputs([mount, manoeuvre], json_out=json_out)
+    check_outputs([mount, manoeuvre, *data_files(mount, manoeuvre)], json_out=json_out)
     import mechanics
     from align.errors import CheckFailed
     from align.present.text import margin_summary
@@ -112,9 +110,10 @@ def check(
     allow = compute(_read_manoeuvre(manoeuvre))
     table = check_margins(b.elements(value(basis)), allow, value(basis))
     table = table.replace(inputs={"mount": str(mount), "manoeuvre": str(manoeuvre)})
+    with outputs() as out:
+        if json_out is not None:
+            out.write_json(json_out, table)
     typer.echo(margin_summary(table.rows, table.basis))
-    if json_out is not None:
-        save_json(json_out, table)
     if not table.passed:
         raise CheckFailed(f"the budget ({table.basis}) exceeds the allowance for {', '.join(table.failed)}")
 

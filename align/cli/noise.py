@@ -5,14 +5,15 @@ Public names
 allan, plan, COMMANDS
 """
 
+import math
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
 from align.cli import options as opt
-from align.cli.options import names
-from align.cli.paths import check_outputs, save_json
+from align.cli.options import ACCURACY, NONNEGATIVE, NONZERO, PAUSE, POSITIVE, names
+from align.cli.paths import check_outputs, outputs
 from align.cli.progress import progress
 
 GRIDS = ("dense", "octave", "decade")
@@ -22,17 +23,19 @@ def grid_value(text: str) -> str | list[float]:
     """``dense``, ``octave``, ``decade`` or a comma list of taus in seconds."""
     if text in GRIDS:
         return text
+    advice = "give dense, octave, decade or a comma list of taus > 0 in seconds, e.g. '0.01,0.1,1'"
     try:
         taus = [float(v) for v in text.split(",") if v.strip()]
     except ValueError:
-        raise ValueError(f"'{text}' is not dense, octave, decade or a comma list of taus in seconds") from None
-    if not taus or min(taus) <= 0:
-        raise ValueError("taus must be positive seconds")
+        raise ValueError(f"'{text}' is not a grid; {advice}") from None
+    if not taus or not all(math.isfinite(t) and t > 0 for t in taus):
+        raise ValueError(advice)
     return taus
 
 
-NoiseRatio = Annotated[float, typer.Option("--noise-ratio", help="Plan for noise this many times below the goal.")]
+NoiseRatio = opt.Number("--noise-ratio", "Plan for noise this many times below the goal (> 0).", POSITIVE, "10", "RATIO")
 Accuracy = "Alignment goal, e.g. '0.1 deg'"
+Rate = "Table rate, e.g. '100 deg/s'"
 
 
 def allan(
@@ -44,16 +47,17 @@ def allan(
     units: opt.Units("Any rate or acceleration unit instead of --gyro-units (e.g. g).") = None,
     grid: Annotated[str, typer.Option("--grid", parser=grid_value, metavar="GRID",
                                       help="dense | octave | decade | explicit taus '0.01,0.1,1' (s).")] = "dense",
-    per_decade: Annotated[int, typer.Option("--per-decade", min=1, help="Points per decade of the dense grid.")] = 10,
-    modified: Annotated[bool, typer.Option("--modified", help="Also the modified Allan deviation.")] = False,
+    per_decade: opt.Whole("--per-decade", "Points per decade of the dense grid (1 to 1000).", 1, 1000, "10") = 10,
+    modified: opt.Flag("--modified/--no-modified", "Also the modified Allan deviation.") = False,
     json_out: opt.JsonOut = None,
     plot: opt.OptInput("--plot", "Log-log plot with confidence band and fit (PNG).", "FILE.png") = None,
     rate: opt.OptQuantity("--rate", "angular_rate", "Table rate, to plan: draws the target and the averaging time.",
-                      "RATE") = None,
-    accuracy: opt.OptQuantity("--accuracy", "angle", Accuracy + ", to plan (with --rate).", "ANGLE") = None,
+                      "RATE", POSITIVE, "'100 deg/s'") = None,
+    accuracy: opt.OptQuantity("--accuracy", "angle", Accuracy + ", to plan (with --rate).", "ANGLE", ACCURACY,
+                              "'0.1 deg'") = None,
     noise_ratio: NoiseRatio = 10.0,
-    memory_limit_mb: Annotated[float, typer.Option("--memory-limit-mb", help=(
-        "Phase kept in memory up to this size; beyond it, a temporary file."))] = 2000.0,
+    memory_limit_mb: opt.Number("--memory-limit-mb", "Phase kept in memory up to this size (MB); beyond it, a temporary "
+                                "file.", POSITIVE, "2000", "MB") = 2000.0,
 ) -> None:
     """Allan deviation, noise-model fit and noise figures of static recordings."""
     from align.errors import InputError
@@ -73,42 +77,40 @@ def allan(
     runs, fs = read_runs(logs, channels, rate_hz)
     with progress(runs[0].shape[0], "Allan deviation (samples read)") as tick:
         job = run_allan(runs, fs, channels, unit, grid, per_decade, modified, progress=tick,
-                        memory_limit=memory_limit_mb * 1e6)
+                        memory_limit=memory_limit_mb * 1e6, where=[str(p) for p in logs])
     job = job.replace(inputs=tuple(str(p) for p in logs))
     if rate is not None:
         job = job.replace(plan=plan_from_allan(job, rate, accuracy, noise_ratio, "measured curve (worst channel)"))
+    with outputs() as out:  # all or none: the plot is drawn before anything is written
+        if plot is not None:
+            from align.present.plots import allan_plot_png
+
+            out.write_bytes(plot, allan_plot_png(job, *((job.plan.noise_target, job.plan.averaging.tau) if job.plan
+                                                        else ())))
+        if json_out is not None:
+            out.write_json(json_out, job)
     typer.echo(allan_summary(job))
     if job.plan is not None:
         typer.echo("\n" + plan_summary(job.plan))
-    png = None
-    if plot is not None:
-        from align.present.plots import allan_plot_png
-
-        png = allan_plot_png(job, *((job.plan.noise_target, job.plan.averaging.tau) if job.plan else ()))
-    if json_out is not None:
-        save_json(json_out, job)
-    if png is not None:
-        from align.io import write_bytes
-
-        write_bytes(plot, png)
 
 
 def plan(
-    rate: opt.Quantity("--rate", "angular_rate", "Table rate, e.g. '100 deg/s'.", "RATE"),
-    accuracy: opt.Quantity("--accuracy", "angle", Accuracy + ".", "ANGLE"),
+    rate: opt.Quantity("--rate", "angular_rate", Rate + ".", "RATE", POSITIVE, "'100 deg/s'"),
+    accuracy: opt.Quantity("--accuracy", "angle", Accuracy + ".", "ANGLE", ACCURACY, "'0.1 deg'"),
     noise_ratio: NoiseRatio = 10.0,
-    arw: Annotated[str | None, typer.Option("--arw", metavar="ARW", help=(
-        "Angle random walk, e.g. '0.3 deg/sqrt(h)'."))] = None,
-    bias_instability: Annotated[str | None, typer.Option("--bias-instability", metavar="RATE", help=(
-        "Bias instability, e.g. '6 deg/h' (with --arw)."))] = None,
-    rate_random_walk: Annotated[str | None, typer.Option("--rate-random-walk", metavar="RRW", help=(
-        "Rate random walk, e.g. '3 deg/h/sqrt(h)' (with --arw)."))] = None,
+    arw: opt.Text("--arw", "angle_random_walk", "Angle random walk, e.g. '0.3 deg/sqrt(h)'.", "ARW", POSITIVE,
+                  "'0.3 deg/sqrt(h)'") = None,
+    bias_instability: opt.Text("--bias-instability", "angular_rate", "Bias instability, e.g. '6 deg/h' (with --arw).",
+                               "RATE", NONNEGATIVE, "'6 deg/h'") = None,
+    rate_random_walk: opt.Text("--rate-random-walk", "rate_random_walk", "Rate random walk, e.g. '3 deg/h/sqrt(h)' "
+                               "(with --arw).", "RRW", NONNEGATIVE, "'3 deg/h/sqrt(h)'") = None,
     imu: Annotated[str | None, typer.Option("--imu", metavar="PART", help=(
         "A datasheet preset (see 'budget'), e.g. ADIS16485."))] = None,
     allan_json: opt.OptInput("--allan", "A result of 'imu-align allan --json'.", "ALLAN.json") = None,
-    turn_angle: opt.Quantity("--turn-angle", "angle", "Turn of the angle method.", "ANGLE") = "360 deg",
-    settle: opt.Quantity("--settle", "time", "Settling time added to each step.", "TIME") = "2 s",
-    steps: Annotated[int, typer.Option("--steps", min=1, help="Table steps (6: +/- about three axes).")] = 6,
+    turn_angle: opt.Quantity("--turn-angle", "angle", "Turn of the angle method.", "ANGLE", NONZERO,
+                             "'360 deg'") = "360 deg",
+    settle: opt.Quantity("--settle", "time", "Settling time added to each step.", "TIME", PAUSE, "'2 s'") = "2 s",
+    steps: opt.Whole("--steps", "Table steps (6: +/- about three axes).", 1, 10_000, "6") = 6,
     json_out: opt.JsonOut = None,
 ) -> None:
     """Averaging time per table step for an alignment goal (Example 3), and the whole plan."""
@@ -119,8 +121,6 @@ def plan(
                          "RESULT.json", "plan")
     if arw is None and (bias_instability or rate_random_walk):
         raise InputError("goes with {arw}", "{bias_instability}" if bias_instability else "{rate_random_walk}")
-    if rate <= 0 or accuracy <= 0 or noise_ratio <= 0:
-        raise InputError("rate, accuracy and noise ratio must be positive", "{rate}")
     check_outputs([allan_json], json_out=json_out)
     from align.noise import AllanJob, make_plan, plan_from_allan, preset_model
     from align.parts import get_part
@@ -137,9 +137,10 @@ def plan(
         else:
             label, curve = preset_model(get_part(imu, "{imu}"))
         result = make_plan(rate, accuracy, noise_ratio, label, sigma=curve, **common)
+    with outputs() as out:
+        if json_out is not None:
+            out.write_json(json_out, result)
     typer.echo(plan_summary(result))
-    if json_out is not None:
-        save_json(json_out, result)
 
 
 def _model_curve(arw: str, bias_instability: str | None, rate_random_walk: str | None):

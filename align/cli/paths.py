@@ -1,4 +1,4 @@
-"""Output paths: checked before a command computes anything, written after it succeeded.
+"""Output paths: checked before a command computes anything, written all together after it succeeded.
 
 Every output a command writes (``--json``, ``--c-header``, ``--plot``,
 ``--picture``, ``--glb``, ``--out``, ``--imucal-json``, an output folder) is
@@ -8,9 +8,13 @@ the command's inputs, and no two outputs are the same file. A failure is one
 :class:`~align.errors.InputError` naming the option (as a placeholder that
 :func:`align.cli.options.spell` renders).
 
+A command then stages every output in an :class:`align.io.outputs.Outputs`
+as it computes it and commits them together at its end: a failed run leaves
+no output at all (:func:`outputs`).
+
 Public names
 ------------
-check_outputs, output_folder, save_json
+check_outputs, output_folder, outputs
 """
 
 from __future__ import annotations
@@ -32,16 +36,17 @@ def _same(a: Path, b: Path) -> bool:
     return a.resolve() == b.resolve()
 
 
-def _check_file(field: str, path: Path, inputs: list[Path]) -> None:
+def _check_file(field: str, path: Path, inputs: list[Path], in_new_folder: bool = False) -> None:
     where = "{" + field + "}"
     if path.is_dir():
         raise InputError(f"{path} is a folder; give a file name", where)
-    parent = path.parent
-    if parent.exists() and not parent.is_dir():
-        raise InputError(f"{parent} is a file, not a folder; give a path in a folder", where)
-    if not parent.is_dir():
-        raise InputError(f"folder {parent} does not exist; create it first", where)
-    _writable(parent, where)
+    if not in_new_folder:
+        parent = path.parent
+        if parent.exists() and not parent.is_dir():
+            raise InputError(f"{parent} is a file, not a folder; give a path in a folder", where)
+        if not parent.is_dir():
+            raise InputError(f"folder {parent} does not exist; create it first", where)
+        _writable(parent, where)
     for p in inputs:
         if _same(path, p):
             raise InputError(f"{path} is also an input of this command; write to another file", where)
@@ -65,36 +70,66 @@ def check_outputs(inputs: Iterable[Path | None] = (), folder: tuple[str, Path, I
     inputs : iterable of Path or None
         The files the command reads (None: not given).
     folder : (field, Path, names), optional
-        An output folder (created when missing) and the names of the files it will hold.
+        An output folder and the names of the files it will hold; a missing folder is
+        created by the run's :class:`~align.io.outputs.Outputs` (and removed again if the run fails).
     **outputs : Path or None
         Output files by field name (``json_out=...``, ``c_header=...``); None: not given.
     """
     ins = [Path(p) for p in inputs if p is not None]
-    seen: list[tuple[str, Path]] = []
+    seen: list[tuple[str, Path, bool]] = []
     if folder is not None:
         field, path, names = folder
-        output_folder(field, path)
-        seen += [(field, path / name) for name in names]
-    seen += [(field, Path(p)) for field, p in outputs.items() if p is not None]
-    for i, (field, path) in enumerate(seen):
-        _check_file(field, path, ins)
-        for other, earlier in seen[:i]:
+        new = output_folder(field, path)
+        seen += [(field, path / name, new) for name in names]
+    seen += [(field, Path(p), False) for field, p in outputs.items() if p is not None]
+    for i, (field, path, new) in enumerate(seen):
+        _check_file(field, path, ins, new)
+        for other, earlier, _ in seen[:i]:
             if _same(path, earlier):
                 raise InputError(f"{path} is also the output of {{{other}}}; give each output its own file", "{" + field + "}")
 
 
-def output_folder(field: str, path: Path) -> None:
-    """Create the output folder ``path`` (and its parents) unless it exists; refuse a file."""
-    if path.exists() and not path.is_dir():
-        raise InputError(f"{path} is a file; give a folder", "{" + field + "}")
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise InputError(f"cannot create folder {path} ({exc.strerror})", "{" + field + "}") from None
+def output_folder(field: str, path: Path) -> bool:
+    """Check that the output folder ``path`` can hold the run's files: an existing, writable folder, or a
+    missing one that can be created (its nearest existing parent is a writable folder). True when missing."""
+    where = "{" + field + "}"
+    if path.exists():
+        if not path.is_dir():
+            raise InputError(f"{path} is a file; give a folder", where)
+        _writable(path, where)
+        return False
+    parent = path.parent
+    while not parent.exists() and parent != parent.parent:
+        parent = parent.parent
+    if not parent.is_dir():
+        raise InputError(f"cannot create folder {path}: {parent} is a file", where)
+    _writable(parent, where)
+    return True
 
 
-def save_json(path: Path, result) -> None:
-    """Write a result file (:func:`align.results.save_result`, imported only when a result is written)."""
-    from align.results import save_result
+def data_files(mount: Path | None = None, manoeuvre: Path | None = None) -> list[Path]:
+    """The data files a mount file (its baseplate STL) and a manoeuvre file (its rate series) name: inputs
+    too, which no output may overwrite. Lenient: a file that cannot be read names none here (its reader
+    refuses it later, in its turn)."""
+    import tomllib
 
-    save_result(path, result)
+    from align.sensitivity.manoeuvre import manoeuvre_inputs
+    from mechanics.mount import mount_inputs
+
+    found: list[Path] = []
+    for path, listed in ((mount, mount_inputs), (manoeuvre, manoeuvre_inputs)):
+        if path is None:
+            continue
+        try:
+            data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+        except (OSError, ValueError):  # missing, a folder, not UTF-8, not TOML
+            continue
+        found += listed(data, Path(path).parent)
+    return found
+
+
+def outputs():
+    """The outputs of this run, all or none: ``with outputs() as out: out.write_json(path, result)``."""
+    from align.io.outputs import Outputs
+
+    return Outputs()

@@ -6,13 +6,13 @@ report, demo, COMMANDS
 """
 
 from pathlib import Path
-from typing import Annotated
 
 import typer
 
 from align.cli import options as opt
 from align.cli.mechanics import MANOEUVRE_HELP, MOUNT_HELP
-from align.cli.paths import check_outputs, save_json
+from align.cli.options import ACCURACY, POSITIVE
+from align.cli.paths import check_outputs, data_files, outputs
 from align.cli.progress import progress
 
 #: the files ``demo`` writes into its folder
@@ -31,8 +31,10 @@ def report(
     rate_hz: opt.RateHz("Sample rate of the static recording, when it has no time column.") = None,
     units: opt.UnitFlag("--units", "Unit of the static recording (an angular rate).") = "deg/s",
     gyro_units: opt.GyroUnits("Unit of the rate-table log (--log).") = "deg/s",
-    rate: Annotated[str, typer.Option("--rate", metavar="RATE", help="Table rate for the plan.")] = "100 deg/s",
-    accuracy: Annotated[str, typer.Option("--accuracy", metavar="ANGLE", help="Alignment goal for the plan.")] = "0.1 deg",
+    rate: opt.Text("--rate", "angular_rate", "Table rate for the plan.", "RATE", POSITIVE, "'100 deg/s'",
+                   optional=False) = "100 deg/s",
+    accuracy: opt.Text("--accuracy", "angle", "Alignment goal for the plan.", "ANGLE", ACCURACY, "'0.1 deg'",
+                       optional=False) = "0.1 deg",
     monte_carlo: opt.MonteCarlo("Monte Carlo draws of the budget.") = 100_000,
     seed: opt.Seed = 0,
 ) -> None:
@@ -41,8 +43,7 @@ def report(
 
     if (log is None) != (plan is None):
         raise InputError("give {log} and {plan} together", "{log}" if log is None else "{plan}")
-    check_outputs([mount, manoeuvre, log, plan, allan_log], out=out)
-    from align.io import write_text
+    check_outputs([mount, manoeuvre, log, plan, allan_log, *data_files(mount, manoeuvre)], out=out)
     from align.present.story import build_report
 
     with progress(monte_carlo, "Monte Carlo") as tick:
@@ -50,7 +51,8 @@ def report(
             mount, manoeuvre, log=log, plan=plan, allan=allan_log, allan_columns=columns, allan_rate_hz=rate_hz,
             allan_units=units, gyro_units=gyro_units, table_rate=rate, accuracy=accuracy, monte_carlo=monte_carlo,
             seed=seed, progress=tick)
-    write_text(out, page)
+    with outputs() as staged:
+        staged.write_text(out, page)
     typer.echo(summary + f"\nreport: {out}")
 
 
@@ -60,14 +62,16 @@ def demo(
 ) -> None:
     """The whole story on bundled inputs (Examples 1-3, simulated records): summary and report."""
     check_outputs(folder=("out", out, DEMO_FILES))
-    from align.io import write_text
     from align.present.story import run_demo
 
-    with progress(100_000, "Monte Carlo") as tick:
-        page, summary, results = run_demo(out, progress=tick)
-    for name, result in results.items():
-        save_json(out / f"{name}.json", result)
-    write_text(out / "report.html", page)
+    # all or none: the inputs are staged and read back, the results and the report staged beside them,
+    # and only then are all the files (and the folder, if new) put in place
+    with outputs() as staged, progress(100_000, "Monte Carlo") as tick:
+        staged.folder(out)
+        page, summary, results = run_demo(out, staged, progress=tick)
+        for name, result in results.items():
+            staged.write_json(out / f"{name}.json", result)
+        staged.write_text(out / "report.html", page)
     typer.echo("imu-align demo (inputs: the reference's Examples 1-3, a simulated static record and rate-table session)\n"
                + summary + f"\nwrote {out}/report.html and the JSON results beside it")
 

@@ -3,13 +3,37 @@
 Public names
 ------------
 read_columns, read_log, read_static, NpyChunks, check_finite, check_time, check_log (from ``logs``);
-existing_file, read_toml, read_json, write_json, write_text, write_bytes, write_csv (from ``files``);
-c_header (from ``export``)
+existing_file, read_text, decode_text, read_toml, read_json, write_json, write_text, write_bytes, write_csv
+(from ``files``); check_keys and the key helpers (``keys``);
+Outputs (``outputs``: a run's files written all together or not at all); c_header (from ``export``)
 """
 
 from align.io.export import c_header
-from align.io.files import existing_file, read_json, read_toml, write_bytes, write_csv, write_json, write_text
-from align.io.logs import NpyChunks, check_finite, check_log, check_time, read_columns, read_log, read_static
+from align.io.files import (
+           decode_text,
+           existing_file,
+           read_json,
+           read_text,
+           read_toml,
+           write_bytes,
+           write_csv,
+           write_json,
+           write_text,
+)
+from align.io.keys import check_keys
+from align.io.logs import (
+           MAX_READING,
+           NpyChunks,
+           check_finite,
+           check_log,
+           check_readings,
+           check_time,
+           read_columns,
+           read_log,
+           read_static,
+)
+from align.io.outputs import Outputs
 
-__all__ = ["c_header", "existing_file", "read_json", "read_toml", "write_bytes", "write_csv", "write_json", "write_text",
-           "NpyChunks", "check_finite", "check_log", "check_time", "read_columns", "read_log", "read_static"]
+__all__ = ["c_header", "decode_text", "read_text", "existing_file", "read_json", "read_toml", "write_bytes", "write_csv",
+           "write_json", "write_text", "check_keys", "Outputs", "MAX_READING", "check_readings", "NpyChunks",
+           "check_finite", "check_log", "check_time", "read_columns", "read_log", "read_static"]

@@ -1,15 +1,19 @@
 """Files: TOML and JSON in, atomic writes out.
 
 Writers are atomic (a temporary file renamed into place), so a failed run never
-leaves a half-written output; readers name the file and line of a syntax error.
+leaves a half-written output. Readers refuse in one line naming the file: a
+missing file or a folder, text that is not UTF-8 (the byte and its line), a
+syntax error (its line), an empty file, a JSON key given twice. The keys of the
+tables read are checked by :mod:`align.io.keys`.
 
 Public names
 ------------
-existing_file, read_toml, read_json, write_json, write_text, write_bytes, write_csv, to_json_value
+existing_file, decode_text, read_text, read_toml, read_json, write_json, write_text, write_bytes, write_csv, to_json_value
 """
 
 from __future__ import annotations
 
+import codecs
 import json
 import os
 import tempfile
@@ -22,29 +26,97 @@ from align.errors import InputError
 
 
 def existing_file(path: str | Path) -> Path:
-    """``path`` as a Path; an InputError when it is not an existing file."""
+    """``path`` as a Path; an InputError when it is not an existing file (or is a folder)."""
     p = Path(path)
+    if p.is_dir():
+        raise InputError("is a folder, not a file", str(path))
     if not p.is_file():
         raise InputError("file not found", str(path))
     return p
 
 
-def read_toml(path: str | Path) -> dict:
-    """Parse a TOML file; a syntax error names the file and line."""
+def decode_text(raw: bytes, where: str) -> str:
+    """``raw`` as UTF-8 text (a leading byte-order mark dropped); one line naming ``where`` otherwise.
+
+    Parameters
+    ----------
+    raw : bytes
+        The file's bytes.
+    where : str
+        The file, for the message.
+
+    Raises
+    ------
+    InputError
+        For UTF-16 text, a binary file (NUL bytes) or bytes that are not UTF-8
+        (naming the first bad byte, its offset and line).
+    """
+    if raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        raise InputError("is UTF-16 text; save it as UTF-8", where)
+    skip = len(codecs.BOM_UTF8) if raw.startswith(codecs.BOM_UTF8) else 0
+    try:
+        text = raw[skip:].decode("utf-8")
+    except UnicodeDecodeError as exc:
+        at = exc.start + skip
+        line = raw[:at].count(b"\n") + 1
+        raise InputError(f"not UTF-8 text (byte 0x{raw[at]:02x} at offset {at}, line {line}); save it as UTF-8",
+                         where) from None
+    if "\x00" in text:
+        raise InputError("holds NUL bytes: a binary file, not text", where)
+    return text
+
+
+def read_text(path: str | Path) -> str:
+    """The text of an existing UTF-8 file; every problem (missing, a folder, unreadable, not UTF-8) one line."""
     p = existing_file(path)
     try:
-        with open(p, "rb") as fh:
-            return tomllib.load(fh)
+        raw = p.read_bytes()
+    except OSError as exc:
+        raise InputError(f"cannot read ({exc.strerror or exc})", str(path)) from None
+    return decode_text(raw, str(path))
+
+
+def read_toml(path: str | Path) -> dict:
+    """Parse a TOML file; a syntax error names the file and line, an empty file is refused."""
+    text = read_text(path)
+    try:
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"not valid TOML ({exc})", str(path)) from None
+    except RecursionError:
+        raise InputError("not valid TOML (nested too deeply)", str(path)) from None
+    except ValueError as exc:   # e.g. an integer of thousands of digits
+        raise InputError(f"not valid TOML ({exc})", str(path)) from None
+    if not data:
+        raise InputError("is empty: no tables or keys", str(path))
+    return data
+
+
+class _DuplicateKey(ValueError):
+    pass
+
+
+def _refuse_duplicates(pairs: list) -> dict:
+    out = {}
+    for key, value in pairs:
+        if key in out:
+            raise _DuplicateKey(key)
+        out[key] = value
+    return out
 
 
 def read_json(path: str | Path) -> dict:
-    """Parse a JSON object; a syntax error names the file."""
-    p = existing_file(path)
+    """Parse a JSON object; a syntax error names the file, a key given twice is refused."""
+    text = read_text(path)
+    if not text.strip():
+        raise InputError("is empty: expected a JSON object", str(path))
     try:
-        data = json.loads(p.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        data = json.loads(text, object_pairs_hook=_refuse_duplicates)
+    except _DuplicateKey as exc:
+        raise InputError(f"key '{exc}' is given twice in one object; keep one", str(path)) from None
+    except RecursionError:
+        raise InputError("not valid JSON (nested too deeply)", str(path)) from None
+    except ValueError as exc:   # JSONDecodeError, or an integer of thousands of digits
         raise InputError(f"not valid JSON ({exc})", str(path)) from None
     if not isinstance(data, dict):
         raise InputError("expected a JSON object at the top level", str(path))

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from align.errors import InputError
+from align.io.logs import check_readings
 from align.noise.model import NOISE_ALPHA
 from align.values import Value, frozen_array
 
@@ -104,7 +105,8 @@ class ArrayChunks:
             yield np.asarray(self.data[start : start + rows, cols], dtype=np.float64)
 
 
-def _phases(source, fs: float, memory_limit: float, names, progress=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _phases(source, fs: float, memory_limit: float, names, progress=None,
+            where: str | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Phases ``[0, cumsum(y - c) / fs]`` of every column in one pass, shape (C, n + 1).
 
     ``c`` is the mean of the first chunk (the whole column when it fits one
@@ -127,11 +129,10 @@ def _phases(source, fs: float, memory_limit: float, names, progress=None) -> tup
     pos, carry, total, const = 1, np.zeros(c), np.zeros(c), None
     for chunk in source.chunks():
         k = len(chunk)
-        bad = ~np.isfinite(chunk)
-        if bad.any():
-            row, col = np.argwhere(bad)[0]
-            raise InputError(f"NaN or infinite sample (first at sample {pos - 1 + row}); repair or cut the record",
-                             names[col])
+        try:
+            check_readings(chunk, where or "record", first_row=pos - 1)  # samples count from 0
+        except InputError as exc:  # named by sample: a chunk source has no header row
+            raise InputError(exc.message.replace("data row", "sample"), exc.where) from None
         if const is None:
             const = np.array([np.mean(chunk[:, j]) for j in range(c)])
         for j in range(c):
@@ -241,6 +242,11 @@ class AllanResult(Value):
     def __post_init__(self) -> None:
         super().__post_init__()
         object.__setattr__(self, "names", tuple(self.names))
+        t = np.shape(self.tau)
+        if len(t) != 1 or np.shape(self.m) != t or np.shape(self.adev) != (len(self.names), t[0]) or (
+                self.mdev is not None and np.shape(self.mdev) != np.shape(self.adev)):
+            raise ValueError(f"tau {t}, m {np.shape(self.m)}, adev {np.shape(self.adev)} do not match "
+                             f"{len(self.names)} channels")
         if self.stability is not None:
             object.__setattr__(self, "stability", {float(p): frozen_array(v) for p, v in self.stability.items()})
 
@@ -257,7 +263,8 @@ class AllanResult(Value):
 
 
 def allan(data, fs: float, names=None, grid="dense", per_decade: int = 10, modified: bool = False,
-          memory_limit: float = 2e9, progress=None, periods=(1.0, 10.0), deviations: bool = True) -> AllanResult:
+          memory_limit: float = 2e9, progress=None, periods=(1.0, 10.0), deviations: bool = True,
+          where: str | None = None) -> AllanResult:
     """Overlapping (and optionally modified) Allan deviation of each column, and the seed's figures.
 
     Parameters
@@ -280,19 +287,24 @@ def allan(data, fs: float, names=None, grid="dense", per_decade: int = 10, modif
         Averaging periods (s) of the bias stability.
     deviations : bool
         False skips the deviations (left NaN) when only the bias figures are wanted.
+    where : str, optional
+        The recording (its file), for messages.
 
     Raises
     ------
     InputError
-        NaN or infinite samples (the first one is named).
+        NaN, infinite or absurdly large samples (the first one is named, with ``where``), a sample rate that is
+        not finite and positive.
     """
+    if not (np.isfinite(fs) and fs > 0):
+        raise InputError(f"the sample rate must be a finite number of Hz > 0, not {float(fs)!r}", "{fs}")
     source = data if hasattr(data, "chunks") else ArrayChunks(data)
     n, c = source.shape
     names = tuple(names) if names is not None else tuple(f"col{j}" for j in range(c))
     m = tau_grid(n, fs, grid, per_decade)
     avar_sums, mvar_sums = _get_kernels()
     tau = m / fs
-    x, _, means = _phases(source, fs, memory_limit, names, progress)
+    x, _, means = _phases(source, fs, memory_limit, names, progress, where)
     adev = np.sqrt(avar_sums(x, m) / (2.0 * tau**2 * (n + 1 - 2 * m))) if deviations else np.full((c, len(m)), np.nan)
     mdev = None
     if modified and deviations:

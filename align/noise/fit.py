@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from align.errors import TestError
 from align.noise.allan import AllanResult, confidence_interval, edf_overlapping
 from align.noise.model import FLICKER_FACTOR, NOISE_ALPHA, TERMS, NoiseModel, avar_design, model_adev
 from align.values import Value
@@ -108,11 +109,19 @@ def _nnls_fit(tau, avar, edf):
     return p, aw, bw
 
 
-def fit_noise(res: AllanResult, channel: int, min_edf: float = 2.0) -> NoiseFit:
-    """Fit the five-term model to one channel of an :class:`AllanResult`."""
+def fit_noise(res: AllanResult, channel: int, min_edf: float = 2.0, where: str | None = None) -> NoiseFit:
+    """Fit the five-term model to one channel of an :class:`AllanResult`.
+
+    Raises
+    ------
+    TestError
+        The channel's Allan deviation is zero (a constant record: a stuck or disconnected sensor)
+        or not reliable at any tau (``where``: the channel, by default its name).
+    """
     tau, adev = res.tau, res.adev[channel]
     avar = adev**2
     edf = edf_overlapping(res.n_phase, res.m, np.zeros(len(tau)))
+    _check_fittable(res, channel, (edf >= min_edf) & (avar > 0), where)
     for _ in range(2):
         use = (edf >= min_edf) & (avar > 0)
         p, aw, bw = _nnls_fit(tau[use], avar[use], edf[use])
@@ -148,6 +157,19 @@ def fit_noise(res: AllanResult, channel: int, min_edf: float = 2.0) -> NoiseFit:
                     point_readouts(tau, adev))
 
 
+def _check_fittable(res: AllanResult, channel: int, use: np.ndarray, where: str | None) -> None:
+    """Refuse a channel with no usable point of its Allan deviation (constant, or nearly so)."""
+    if use.any():
+        return
+    where = where or str(res.names[channel])
+    adev = res.adev[channel]
+    if not np.any(adev > 0):
+        raise TestError("the record is constant (Allan deviation 0 at every tau): a stuck or disconnected sensor, or "
+                        "a column of zeros? record the sensor while it runs", where)
+    raise TestError(f"the Allan deviation is 0 or unreliable at every tau of this {res.n:,}-sample record (nearly constant: "
+                    "coarse quantisation?); record longer or at a finer resolution", where)
+
+
 def _why(term, params, share, rel, tau, use, hi, model, res) -> str:
     """A sentence on why a term is not identifiable and, for slow terms, the record needed."""
     T = res.n / res.fs
@@ -158,7 +180,9 @@ def _why(term, params, share, rel, tau, use, hi, model, res) -> str:
     # the largest value the longest reliable tau (edf >= 5) allows, and where a term that size would show
     reliable = np.flatnonzero(use & (res.n_phase - 2 * res.m >= 5))
     last = reliable[-1] if len(reliable) else np.flatnonzero(use)[-1]
-    room = max(hi[last] ** 2 - model[last], 1e-300)
+    if not hi[last] ** 2 > model[last]:  # the fit already fills the interval: no room for a bound
+        return f"{term}: not identifiable from this {T / 3600:.3g} h record (largest share of the curve {100 * share:.0f} %)"
+    room = hi[last] ** 2 - model[last]
     floor = max(FLICKER_FACTOR * params[2] ** 2 + params[1] ** 2 / tau[last], 1e-300)
     if term == "random_walk":
         bound = np.sqrt(3 * room / tau[last])
@@ -181,9 +205,13 @@ def point_readouts(tau: np.ndarray, adev: np.ndarray) -> dict:
     read at tau = 1 s; ``B_floor``: the curve minimum / 0.664; ``K_tau3``: the slope
     +1/2 line through points of local slope +1/2 +/- 0.1, read at tau = 3 s.
     """
+    out = {}
+    keep = np.asarray(adev) > 0  # a zero deviation has no logarithm
+    tau, adev = np.asarray(tau)[keep], np.asarray(adev)[keep]
+    if len(tau) == 0:
+        return {"N_tau1": float("nan"), "B_floor": 0.0, "K_tau3": float("nan")}
     lt, la = np.log(tau), np.log(adev)
     slope = np.gradient(la, lt) if len(tau) > 2 else np.zeros_like(tau)
-    out = {}
     white = np.abs(slope + 0.5) < 0.1
     out["N_tau1"] = float(np.exp(np.median(la[white] + 0.5 * lt[white]))) if white.any() else float("nan")
     out["B_floor"] = float(np.min(adev) / 0.664)

@@ -20,11 +20,13 @@ from typing import Any
 import numpy as np
 
 from align.errors import InputError
+from align.io.keys import check_keys
 from align.noise.allan import NOISE_ALPHA, AllanResult, allan, edf_overlapping
 from align.noise.fit import NoiseFit, fit_noise
 from align.noise.model import TERMS, avar_design
 from align.noise.planner import PlanResult, make_plan
-from align.results import Result, file_unit
+from align.plausible import malformed
+from align.results import Result, envelope, file_unit
 from align.units import parse_unit, to_unit
 
 FORMAT = "imu-align.allan"
@@ -46,6 +48,14 @@ def term_units(units: str) -> tuple[str, ...]:
     """Engineering units of Q, N, B, K, R for data in ``units`` (a rate or an acceleration)."""
     u = parse_unit(units)
     return _GYRO if u.dim == parse_unit("rad/s").dim else _ACCEL
+
+
+#: the fewest samples a recording may hold: a handful of taus per decade for the five-term fit
+MIN_SAMPLES = 100
+
+#: the keys of an Allan file after its envelope (a misspelled key is refused, not ignored)
+FILE_KEYS = ("sensor", "fs_hz", "samples", "runs", "tau", "m", "adev", "ci_low", "ci_high", "fit", "figures", "periods_s",
+             "adev_run_figures", "inputs", "mdev", "adev_of", "repeatability", "plan")
 
 
 class AllanJob(Result, format=FORMAT, convention=CONVENTION):
@@ -147,6 +157,7 @@ class AllanJob(Result, format=FORMAT, convention=CONVENTION):
         """Read the form written by :meth:`to_dict` (files written before ``m``, ``edf``,
         ``dominant`` and ``adev_run_figures`` were added read too: those are rebuilt)."""
         cls.check_envelope(d, where)
+        check_keys(d, [*envelope(cls.FORMAT, cls.VERSION, cls.CONVENTION), *FILE_KEYS], where)
         try:
             u, f = file_unit(d, "adev", None, where)
             tu = term_units(u)
@@ -171,8 +182,8 @@ class AllanJob(Result, format=FORMAT, convention=CONVENTION):
             return cls(result, fits, figures, None if rep is None else np.array([rep[k] for k in names], dtype=float) * f,
                        u, runs, tuple(d.get("inputs", ())),
                        PlanResult.from_dict(d["plan"], f"{where}: plan") if "plan" in d else None)
-        except (KeyError, TypeError, ValueError, IndexError) as exc:
-            raise InputError(f"malformed {FORMAT} result ({exc!r}); regenerate it", where) from None
+        except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
+            raise InputError(f"malformed {FORMAT} result ({malformed(exc)}); regenerate it", where) from None
 
 
 def _term(value: float, unit: str) -> float | None:
@@ -227,7 +238,8 @@ def _read_fit(fd: dict[str, Any], tu: tuple[str, ...], result: AllanResult, ci_l
 
 
 def run_allan(runs: list, fs: float, names: list[str], units: str, grid="dense", per_decade: int = 10,
-              modified: bool = False, periods=(1.0, 10.0), progress=None, memory_limit: float = 2e9) -> AllanJob:
+              modified: bool = False, periods=(1.0, 10.0), progress=None, memory_limit: float = 2e9,
+              where: str | list[str] | None = None) -> AllanJob:
     """Allan deviation and fit of the first run, noise figures of every run, the repeatability.
 
     Parameters
@@ -245,18 +257,37 @@ def run_allan(runs: list, fs: float, names: list[str], units: str, grid="dense",
     grid, per_decade, modified, progress, memory_limit : see :func:`align.noise.allan.allan`
     periods : sequence of float
         Averaging periods (s) of the bias stability (seed 002 Eq 7).
+    where : str or list of str, optional
+        The recordings (their files), for messages.
 
     Returns
     -------
     AllanJob
         Set its ``inputs`` (and ``plan``) with ``job.replace(...)``.
+
+    Raises
+    ------
+    InputError
+        A sample rate that is not a finite positive number of Hz.
+        A recording of fewer than :data:`MIN_SAMPLES` samples.
+    TestError
+        A channel whose record is constant (a stuck sensor), named with ``where``.
     """
+    if not (np.isfinite(fs) and fs > 0):
+        raise InputError(f"the sample rate must be a finite number of Hz > 0, not {float(fs)!r}", "{rate_hz}")
     factor = parse_unit(units).factor
+    files = list(where) if isinstance(where, (list, tuple)) else [where] * len(runs)
+    for run, file in zip(runs, files):
+        n = np.shape(run)[0] if not hasattr(run, "chunks") else run.shape[0]
+        if n < MIN_SAMPLES:
+            raise InputError(f"only {n} samples; an Allan deviation and its fit need at least {MIN_SAMPLES} (several "
+                             "taus per decade): record longer", file or "record")
     # the deviations of the first run; of the others only the bias figures (no kernel pass)
     results = [allan(r, fs, names, grid, per_decade, modified, memory_limit, progress=progress if k == 0 else None,
-                     periods=periods, deviations=k == 0).scaled(factor) for k, r in enumerate(runs)]
+                     periods=periods, deviations=k == 0, where=file) for k, (r, file) in enumerate(zip(runs, files))]
+    results = [r.scaled(factor) for r in results]
     res = results[0]
-    fits = tuple(fit_noise(res, j) for j in range(len(names)))
+    fits = tuple(fit_noise(res, j, where=f"{files[0]}: {name}" if files[0] else None) for j, name in enumerate(names))
     figures = tuple({"bias": float(np.mean([r.bias[j] for r in results])),
                      "stability": {p: float(np.mean([r.stability[p][j] for r in results])) for p in periods}}
                     for j in range(len(names)))

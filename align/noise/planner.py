@@ -22,9 +22,11 @@ from typing import Any
 import numpy as np
 
 from align.errors import InputError
+from align.io.keys import check_keys
 from align.noise.model import NoiseModel
 from align.parts import Part
-from align.results import Result
+from align.plausible import malformed
+from align.results import Result, envelope
 from align.units import DEG, DEG_H
 from align.values import Value
 
@@ -122,6 +124,11 @@ def longest_turn(angle_target: float, sigma, t_max: float = 1e5) -> float | None
     return float(np.exp(brentq(g, np.log(1e-6), np.log(t_max), xtol=1e-12)))
 
 
+#: the keys of a plan file after its envelope
+FILE_KEYS = ("rate_deg_s", "accuracy_deg", "noise_ratio", "noise_target_deg_h", "averaging_time_s", "feasible", "reason",
+             "floor_deg_h", "floor_tau_s", "noise_source", "angle_method", "test_plan", "inputs")
+
+
 class PlanResult(Result, format=FORMAT, convention=CONVENTION):
     """A test plan from the noise (SI units: rad/s, rad, s).
 
@@ -190,8 +197,9 @@ class PlanResult(Result, format=FORMAT, convention=CONVENTION):
 
     @classmethod
     def from_dict(cls, d: dict[str, Any], where: str = "result") -> PlanResult:
-        """Read the form written by :meth:`to_dict`."""
+        """Read the form written by :meth:`to_dict`; a key it does not know is refused (a misspelling)."""
         cls.check_envelope(d, where)
+        check_keys(d, [*envelope(cls.FORMAT, cls.VERSION, cls.CONVENTION), *FILE_KEYS], where)
         try:
             am, tp = d["angle_method"], d["test_plan"]
             tau = d["averaging_time_s"]
@@ -205,13 +213,35 @@ class PlanResult(Result, format=FORMAT, convention=CONVENTION):
                 steps=int(tp["steps"]), settle=float(tp["settle_s"]), source=str(d["noise_source"]),
                 inputs=dict(d.get("inputs", {})),
             )
-        except (KeyError, TypeError, ValueError) as exc:
-            raise InputError(f"malformed {FORMAT} result ({exc!r}); regenerate it", where) from None
+        except (KeyError, TypeError, ValueError, AttributeError) as exc:
+            raise InputError(f"malformed {FORMAT} result ({malformed(exc)}); regenerate it", where) from None
 
 
 def make_plan(rate: float, accuracy: float, ratio: float, source: str, tau=None, adev=None, sigma=None,
               turn_angle: float = 2 * np.pi, steps: int = 6, settle: float = 2.0) -> PlanResult:
-    """The planner: noise target, averaging time, angle-method turn limit and the whole plan."""
+    """The planner: noise target, averaging time, angle-method turn limit and the whole plan.
+
+    Raises
+    ------
+    InputError
+        A rate, accuracy or noise ratio that is not finite and positive, a turn angle of 0, fewer
+        than one step or a negative settling time (each named as its input), or a measured curve
+        with no positive finite point.
+    """
+    for name, x in (("rate", rate), ("accuracy", accuracy), ("ratio", ratio)):
+        if not (np.isfinite(x) and x > 0):
+            raise InputError(f"must be finite and > 0 (got {float(x):g})", "{" + name + "}")
+    if not (np.isfinite(turn_angle) and turn_angle != 0):
+        raise InputError(f"must be finite and not 0 (got {float(turn_angle):g})", "{turn_angle}")
+    if int(steps) < 1:
+        raise InputError(f"must be at least 1 (got {int(steps)})", "{steps}")
+    if not (np.isfinite(settle) and settle >= 0):
+        raise InputError(f"must be finite and >= 0 (got {float(settle):g})", "{settle}")
+    if sigma is None:
+        keep = np.isfinite(np.asarray(adev, float)) & (np.asarray(adev, float) > 0)
+        if not keep.any():
+            raise InputError("the Allan deviation has no positive finite point to plan from; recompute it", "{allan_json}")
+        tau, adev = np.asarray(tau, float)[keep], np.asarray(adev, float)[keep]
     target = noise_target(rate, accuracy, ratio)
     avg = averaging_time(target, tau, adev, sigma)
     if sigma is None:

@@ -2,9 +2,10 @@
 
 :func:`build_report` runs every job whose inputs are given and returns the HTML
 page, a short text summary and the JSON-ready results; :func:`demo_inputs`
-writes the bundled inputs (the reference's Examples 1 and 2, a simulated static
-record and a simulated rate-table session) so that the demo is a report of real
-files like any other.
+stages the bundled inputs (the reference's Examples 1 and 2, a simulated static
+record and a simulated rate-table session) in the run's
+:class:`~align.io.outputs.Outputs`, so that the demo is a report of real files
+like any other, and a demo that fails leaves none of them behind.
 
 Public names
 ------------
@@ -13,20 +14,29 @@ build_report, demo_inputs, run_demo, DEMO_TITLE, DEMO
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
-from align.io import read_log, read_static, read_toml, write_bytes, write_csv, write_text
-from align.units import DEG, DEG_H
+from align.io import read_log, read_static, read_toml
+from align.io.outputs import Outputs
+from align.units import DEG, DEG_H, parse_unit
 from align.units import parse_quantity as q
 
 DEMO = Path(__file__).with_name("demo")
 DEMO_TITLE = "imu-align demo: ADIS16485 on a vehicle antenna platform"
 
 
-def demo_inputs(out: Path, seed: int = 0) -> dict:
-    """Write the demo's inputs into ``out`` and return their paths and reading options."""
+def demo_inputs(out: Path, staged: Outputs | None = None, seed: int = 0) -> dict:
+    """Stage the demo's inputs (their names in ``out``) in ``staged``; return their paths and reading options.
+
+    The files are read back from their staged copies (``staged.staged(path)``) until the run commits;
+    without ``staged`` they are written at once.
+    """
+    if staged is None:
+        with Outputs() as now:
+            return demo_inputs(out, now, seed)
     from align.alignment.plan import Plan
     from align.alignment.simulate import SessionSpec, SimulationTruth, simulate_session
     from align.model import SensorModel
@@ -34,14 +44,14 @@ def demo_inputs(out: Path, seed: int = 0) -> dict:
     from align.units import to_unit
 
     mount, manoeuvre = out / "mount.toml", out / "manoeuvre.toml"
-    write_text(mount, (DEMO / "mount.toml").read_text())
-    write_text(manoeuvre, (DEMO / "manoeuvre.toml").read_text())
+    staged.write_text(mount, (DEMO / "mount.toml").read_text())
+    staged.write_text(manoeuvre, (DEMO / "manoeuvre.toml").read_text())
     rng = np.random.default_rng(seed)
     # a static record with the ADIS16485's datasheet noise (0.3 deg/sqrt(h), 6.25 deg/h), 20 min at 100 Hz
     static = simulate_noise(120_000, 100.0, NoiseSpec(white=q("0.3 deg/sqrt(h)", "angle_random_walk"),
                                                        flicker=q("6.25 deg/h", "angular_rate")), 3, rng)
     static_path = out / "static.npy"
-    write_bytes(static_path, _npy(to_unit(static, "deg/s")))
+    staged.write_bytes(static_path, _npy(to_unit(static, "deg/s")))
     # a +/-100 deg/s six-dwell session of an IMU mounted 0.8 deg off, known truth
     plan = Plan.standard_rate(100 * DEG)
     from scipy.spatial.transform import Rotation
@@ -52,8 +62,8 @@ def demo_inputs(out: Path, seed: int = 0) -> dict:
     t, g, _ = simulate_session(plan, truth, SessionSpec(fs=200.0, dwell_s=8.0, static_s=2.0,
                                                         noise_density=q("0.3 deg/sqrt(h)", "angle_random_walk")), rng)
     log, plan_path = out / "session.csv", out / "plan.toml"
-    write_csv(log, ["time", "gyro_x", "gyro_y", "gyro_z"], np.column_stack([t, to_unit(g, "deg/s")]))
-    write_text(plan_path, plan.to_toml())
+    staged.write_csv(log, ["time", "gyro_x", "gyro_y", "gyro_z"], np.column_stack([t, to_unit(g, "deg/s")]))
+    staged.write_text(plan_path, plan.to_toml())
     return {"mount": mount, "manoeuvre": manoeuvre, "log": log, "plan": plan_path, "allan": static_path,
             "allan_rate_hz": 100.0, "allan_columns": "gyro_x,gyro_y,gyro_z", "truth_M": truth.M,
             "truth": SimulationTruth(truth, "deg/s", seed, {"log": str(log), "plan": str(plan_path)})}
@@ -71,8 +81,13 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
                  allan: Path | None = None, allan_columns: str = "gyro_x,gyro_y,gyro_z", allan_rate_hz: float | None = None,
                  allan_units: str = "deg/s", gyro_units: str = "deg/s", table_rate: str = "100 deg/s",
                  accuracy: str = "0.1 deg", noise_ratio: float = 10.0, monte_carlo: int = 100_000, seed: int = 0,
-                 basis: str = "rss", progress=None, title: str = "IMU alignment report") -> tuple[str, str, dict]:
-    """Run every job whose inputs are given; return (HTML, summary text, results)."""
+                 basis: str = "rss", progress=None, title: str = "IMU alignment report",
+                 source: Callable[[Path], Path] | None = None) -> tuple[str, str, dict]:
+    """Run every job whose inputs are given; return (HTML, summary text, results).
+
+    The inputs are named by their paths; ``source`` maps such a path to the file to read, when
+    that differs (the demo reads its staged inputs: :meth:`align.io.outputs.Outputs.staged`).
+    """
     import align.present.html as report
     from align.sensitivity import allowable, check_margins, manoeuvre_from_dict
     from mechanics.budget import budget
@@ -80,12 +95,13 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
     from mechanics.mount import mount_from_dict
     from mechanics.render import assembly_png, histogram_png
 
-    inputs = {"mount": (str(mount), Path(mount).read_text()), "manoeuvre": (str(manoeuvre), Path(manoeuvre).read_text())}
-    m = mount_from_dict(read_toml(mount), str(mount), Path(mount).parent)
+    src = source or Path
+    m = mount_from_dict(read_toml(src(mount)), str(mount), Path(mount).parent)
     b = budget(m)
     if monte_carlo:
         b = b.replace(monte_carlo=run_mc(m, monte_carlo, seed, progress=progress))
-    man = manoeuvre_from_dict(read_toml(manoeuvre), str(manoeuvre), Path(manoeuvre).parent)
+    man = manoeuvre_from_dict(read_toml(src(manoeuvre)), str(manoeuvre), Path(manoeuvre).parent)
+    inputs = {"mount": (str(mount), _text(src(mount))), "manoeuvre": (str(manoeuvre), _text(src(manoeuvre)))}
     allow = allowable(man)
     table = check_margins(b.elements(basis), allow, basis)
     sections = [report.budget_section(b, histogram_png(b) if monte_carlo else None, assembly_png(m)),
@@ -101,8 +117,9 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
         from align.present.plots import allan_plot_png
 
         names = [c.strip() for c in allan_columns.split(",")]
-        data, fs = read_static(allan, names, allan_rate_hz)
-        job = run_allan([data], fs, names, allan_units)
+        parse_unit(allan_units, "angular_rate", "{allan_units}")  # the plan needs a gyro's record
+        data, fs = read_static(src(allan), names, allan_rate_hz)
+        job = run_allan([data], fs, names, allan_units, where=str(allan))
         pl = plan_from_allan(job, q(table_rate, "angular_rate", "{rate}"), q(accuracy, "angle", "{accuracy}"), noise_ratio,
                              "measured curve (worst channel)")
         job = job.replace(inputs=(str(allan),), plan=pl)
@@ -117,12 +134,12 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
         from align.alignment.job import align
         from align.alignment.plan import Plan
 
-        the_plan = Plan.from_dict(read_toml(plan), str(plan))
-        t, g = read_log(log, ["gyro_x", "gyro_y", "gyro_z"], gyro_units)
+        the_plan = Plan.from_dict(read_toml(src(plan)), str(plan))
+        t, g = read_log(src(log), ["gyro_x", "gyro_y", "gyro_z"], gyro_units)
         r = align(t, g, the_plan, units=gyro_units, where=str(log))
         sections.append(report.alignment_section(r))
         inputs["rate-table log"] = (str(log), "")
-        inputs["plan"] = (str(plan), Path(plan).read_text())
+        inputs["plan"] = (str(plan), _text(src(plan)))
         results["alignment"] = r
         ang = r.angles
         lines.append(f"alignment: psi = {', '.join(f'{v / DEG:.3f}' for v in ang.psi)} deg, "
@@ -130,6 +147,11 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
                      f"checks: {_check_counts(r.checks)}")
     sections.insert(0, report.inputs_section(inputs))
     return report.html_report(title, sections), "\n".join(lines), results
+
+
+def _text(path: Path) -> str:
+    """The text of an input already read by its checked reader, for the report (undecodable bytes shown as such)."""
+    return Path(path).read_bytes().decode("utf-8", "replace")
 
 
 def _check_counts(checks) -> str:
@@ -140,8 +162,10 @@ def _check_counts(checks) -> str:
     return ", ".join(f"{n} {status}" for status, n in counts.items())
 
 
-def run_demo(out: Path, progress=None) -> tuple[str, str, dict]:
-    """The demo: bundled inputs written into ``out``, every job run, the alignment compared with the truth.
+def run_demo(out: Path, staged: Outputs, progress=None) -> tuple[str, str, dict]:
+    """The demo: bundled inputs staged for ``out``, every job run, the alignment compared with the truth.
+
+    Nothing is written until the caller commits ``staged`` (with the results and the report added).
 
     Returns
     -------
@@ -152,10 +176,11 @@ def run_demo(out: Path, progress=None) -> tuple[str, str, dict]:
     results : dict of str to Result
         The jobs' results and the simulation's truth (``"truth"``), each to be saved as ``<name>.json``.
     """
-    inp = demo_inputs(out)
+    inp = demo_inputs(out, staged)
     page, summary, results = build_report(inp["mount"], inp["manoeuvre"], log=inp["log"], plan=inp["plan"],
                                           allan=inp["allan"], allan_columns=inp["allan_columns"],
-                                          allan_rate_hz=inp["allan_rate_hz"], progress=progress, title=DEMO_TITLE)
+                                          allan_rate_hz=inp["allan_rate_hz"], progress=progress, title=DEMO_TITLE,
+                                          source=staged.staged)
     truth = inp["truth"]
     error = float(np.abs(results["alignment"].M - truth.model.M).max())
     summary += f"\nalignment error against the simulation's truth: {error:.1e} (largest element of M)"

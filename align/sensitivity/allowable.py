@@ -6,20 +6,22 @@ of the manoeuvre reaches its limit: by Example 2's closed forms
 where they apply, otherwise by root finding on attitude propagation
 (:mod:`align.sensitivity.attitude`). The smallest is the binding element; the
 cone is the largest rigid mounting rotation, in any direction, that meets every
-limit. :func:`check_margins` sets a predicted budget against the allowance.
+limit.
 
-Results: :class:`Allowable` (``imu-align.allowable``) and :class:`MarginTable`
-(``imu-align.check``), both registered with :mod:`align.results`.
+Result: :class:`Allowable` (``imu-align.allowable``), registered with
+:mod:`align.results`; an allowable file keeps a ``[series]`` manoeuvre as a
+summary without its samples.
 
 Public names
 ------------
-Allowable, allowable, Margin, margins, MarginTable, check_margins
+Allowable, allowable, deg_for_file, rad_from_file (the budget against it: :mod:`align.sensitivity.margins`)
 """
 
 from __future__ import annotations
 
+import hashlib
 import math
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
@@ -30,19 +32,31 @@ from align.sensitivity.attitude import closed_form_errors, output_errors
 from align.sensitivity.manoeuvre import Manoeuvre
 from align.sensitivity.symbolic import ELEMENTS, matrix_from_angles
 from align.units import DEG
-from align.values import Value
 
 ALLOWABLE_CONVENTION = CONVENTION + "; M_ii = cos(psi_i), M_ij = sin(phi_ij) (Eq 5-10)"
 
 
-def _deg(v: float) -> float | None:
+def deg_for_file(v: float) -> float | None:
     """rad -> deg for a file; ``inf`` (unconstrained) as None."""
     return None if not math.isfinite(v) else v / DEG
 
 
-def _rad(v: float | None) -> float:
+def rad_from_file(v: float | None) -> float:
     """deg from a file -> rad; None (unconstrained) as ``inf``."""
     return math.inf if v is None else float(v) * DEG
+
+
+def _series_summary(man: Manoeuvre) -> dict | None:
+    """What an allowable file keeps of a ``[series]`` in place of its samples; None for ``[[rotation]]`` steps.
+
+    ``samples`` (one more than the ``increments`` integrated between them), ``increments_sum_deg``
+    (3,) and ``increments_sha256`` (rad, little-endian float64, row by row), which identifies the series.
+    """
+    if man.segments or len(man.increments) == 0:
+        return None
+    inc = np.ascontiguousarray(man.increments, dtype="<f8")
+    return {"samples": len(inc) + 1, "increments": len(inc), "increments_sum_deg": (inc.sum(axis=0) / DEG).tolist(),
+            "increments_sha256": hashlib.sha256(inc.tobytes()).hexdigest()}
 
 
 class Allowable(Result, format="imu-align.allowable", convention=ALLOWABLE_CONVENTION):
@@ -51,24 +65,22 @@ class Allowable(Result, format="imu-align.allowable", convention=ALLOWABLE_CONVE
     Attributes
     ----------
     allowable : dict
-        Element (:data:`~align.sensitivity.symbolic.ELEMENTS`) -> largest size
-        alone, rad; ``inf`` where no limit is ever reached.
+        Element (:data:`~align.sensitivity.symbolic.ELEMENTS`) -> largest size alone, rad (``inf``: never limited).
     method : dict
         Element -> "closed form" or "numeric (attitude propagation)".
-    binding : str
-        The element with the smallest allowance.
-    binding_value : float
-        Its allowance, rad.
-    cone : float
-        Largest rigid mounting rotation in any direction meeting every limit, rad.
-    cone_direction : ndarray, shape (3,)
-        Unit axis of the tightest such rotation.
+    binding, binding_value : str, float
+        The element with the smallest allowance, and that allowance, rad.
+    cone, cone_direction : float, ndarray of shape (3,)
+        Largest rigid mounting rotation, in any direction, meeting every limit, rad; the tightest one's unit axis.
     agreement : dict
-        Closed form against attitude propagation at the binding element, deg
-        (the ``agreement`` of the file).
+        Closed form against attitude propagation at the binding element, deg (the file's ``agreement``).
     manoeuvre : Manoeuvre
+        Its limits, rad; a ``[series]`` read back from a file has no increments (re-read its file to recompute).
     inputs : dict
         Where the inputs came from (set with ``replace(inputs=...)``).
+    series : dict or None
+        For a ``[series]``, the summary the file keeps in place of its samples (``samples``, ``increments``,
+        ``increments_sum_deg``, ``increments_sha256``); None for ``[[rotation]]`` steps.
     """
 
     allowable: dict
@@ -80,43 +92,66 @@ class Allowable(Result, format="imu-align.allowable", convention=ALLOWABLE_CONVE
     agreement: dict
     manoeuvre: Manoeuvre
     inputs: dict = field(default_factory=dict)
+    series: dict | None = None
 
     def to_dict(self) -> dict:
-        """The versioned JSON form, angles in deg (``None`` for unconstrained)."""
+        """The versioned JSON form, angles in deg (``None`` for unconstrained).
+
+        Returns
+        -------
+        dict
+            ``manoeuvre_detail`` is ``Manoeuvre.to_dict``; for a ``[series]``, ``series`` replaces ``increments_deg``.
+        """
         return {
             **self.envelope({"angles": "deg"}),
             "manoeuvre": self.manoeuvre.description,
             "limits_deg": {k: v / DEG for k, v in self.manoeuvre.limits.items()},
-            "allowable_deg": {k: _deg(v) for k, v in self.allowable.items()},
-            "method": dict(self.method),
-            "binding": self.binding,
-            "binding_deg": self.binding_value / DEG,
-            "cone_deg": self.cone / DEG,
-            "cone_worst_direction": self.cone_direction.tolist(),
-            "agreement": self.agreement,
-            "manoeuvre_detail": self.manoeuvre.to_dict(),
-            "inputs": dict(self.inputs),
+            "allowable_deg": {k: deg_for_file(v) for k, v in self.allowable.items()},
+            "method": dict(self.method), "binding": self.binding, "binding_deg": self.binding_value / DEG,
+            "cone_deg": self.cone / DEG, "cone_worst_direction": self.cone_direction.tolist(),
+            "agreement": self.agreement, "manoeuvre_detail": self._manoeuvre_detail(), "inputs": dict(self.inputs),
         }
+
+    def _manoeuvre_detail(self) -> dict:
+        """The manoeuvre's dictionary; a ``[series]`` summarised, its samples left out."""
+        summary = self.series if self.series is not None else _series_summary(self.manoeuvre)
+        if summary is None:
+            return self.manoeuvre.to_dict()
+        detail = self.manoeuvre.replace(increments=np.empty((0, 3))).to_dict()   # not the samples, even as a list
+        return {**{k: v for k, v in detail.items() if k != "increments_deg"}, "series": dict(summary)}
 
     @classmethod
     def from_dict(cls, d: dict, where: str = "result") -> Allowable:
-        """Read the form written by :meth:`to_dict`.
+        """Read the form written by :meth:`to_dict` (InputError for another format, a newer version, a bad body).
 
-        A file without ``manoeuvre_detail`` (written before it existed) gives a
-        manoeuvre with its description and limits but no increments.
+        A ``[series]`` (summary in :attr:`series`) or an older file without ``manoeuvre_detail`` has no increments.
+
+        Parameters
+        ----------
+        d : dict
+            The parsed JSON.
+        where : str
+            Names the file in error messages.
+
+        Returns
+        -------
+        Allowable
         """
         cls.check_envelope(d, where)
         try:
-            if "manoeuvre_detail" in d:
-                man = Manoeuvre.from_dict(d["manoeuvre_detail"], f"{where}: manoeuvre_detail")
+            detail = d.get("manoeuvre_detail")
+            series = None if detail is None or detail.get("series") is None else dict(detail["series"])
+            if detail is not None:   # a [series] without its samples: no increments
+                man = Manoeuvre.from_dict(detail if series is None else {**detail, "increments_deg": []},
+                                          f"{where}: manoeuvre_detail")
             else:
-                man = Manoeuvre(np.empty((0, 3)), {k: _rad(v) for k, v in d["limits_deg"].items()},
+                man = Manoeuvre(np.empty((0, 3)), {k: rad_from_file(v) for k, v in d["limits_deg"].items()},
                                 description=str(d["manoeuvre"]))
             return cls(
-                allowable={k: _rad(v) for k, v in d["allowable_deg"].items()},
-                method=dict(d["method"]), binding=str(d["binding"]), binding_value=_rad(d["binding_deg"]),
-                cone=_rad(d["cone_deg"]), cone_direction=np.array(d["cone_worst_direction"], float).reshape(3),
-                agreement=dict(d["agreement"]), manoeuvre=man, inputs=dict(d.get("inputs", {})),
+                allowable={k: rad_from_file(v) for k, v in d["allowable_deg"].items()},
+                method=dict(d["method"]), binding=str(d["binding"]), binding_value=rad_from_file(d["binding_deg"]),
+                cone=rad_from_file(d["cone_deg"]), cone_direction=np.array(d["cone_worst_direction"], float).reshape(3),
+                agreement=dict(d["agreement"]), manoeuvre=man, inputs=dict(d.get("inputs", {})), series=series,
             )
         except (KeyError, TypeError, ValueError, AttributeError) as exc:
             raise InputError(f"malformed allowable result ({exc!r}); regenerate it with imu-align allowable",
@@ -151,12 +186,12 @@ def allowable(man: Manoeuvre, directions: int = 200) -> Allowable:
     Each element is raised alone (others zero) until some limit is reached:
     the closed forms ``asin(E / Theta)`` and ``acos(1 - E / Theta)`` (Example 2,
     from Eq 11-13) where they apply, otherwise numeric root finding (Brent) on
-    attitude propagation, both signs, up to 90 deg (``inf`` when never
-    reached).
+    attitude propagation, both signs, up to 90 deg (``inf`` when never reached).
 
     Parameters
     ----------
     man : Manoeuvre
+        Body-frame increments (n, 3), rad, and the limits on its outputs (output name -> rad).
     directions : int
         Points on a sphere searched for the cone (the largest rigid mounting
         rotation, in any direction, that meets every limit).
@@ -164,6 +199,7 @@ def allowable(man: Manoeuvre, directions: int = 200) -> Allowable:
     Returns
     -------
     Allowable
+        Per element the allowance (rad) and how it was found; the binding element, the cone (rad).
     """
     from scipy.optimize import brentq
 
@@ -186,15 +222,12 @@ def allowable(man: Manoeuvre, directions: int = 200) -> Allowable:
     binding = min(ELEMENTS, key=lambda e: allow[e])
     cone, direction = _cone(man, directions)
     agreement = _agreement(man, binding, allow[binding])
-    return Allowable(allow, method, binding, allow[binding], cone, direction, agreement, man)
+    return Allowable(allow, method, binding, allow[binding], cone, direction, agreement, man, series=_series_summary(man))
 
 
 def _cone(man: Manoeuvre, n: int) -> tuple[float, np.ndarray]:
-    """Largest rotation angle of a rigid mounting rotation, in any direction, meeting every limit.
-
-    The root along each of ``n`` directions (a Fibonacci sphere) is found by
-    Brent's method, then the worst direction is refined by Nelder-Mead.
-    """
+    """Largest rigid mounting rotation meeting every limit: Brent's root along each of ``n`` directions
+    (a Fibonacci sphere), the worst direction then refined by Nelder-Mead."""
     from scipy.optimize import brentq, minimize
     from scipy.spatial.transform import Rotation
 
@@ -231,120 +264,9 @@ def _agreement(man: Manoeuvre, element: str, value: float) -> dict:
     closed = closed_form_errors(man, m)
     prop = output_errors(man, m, history=True)
     return {
-        "element": element, "element_deg": _deg(value),
+        "element": element, "element_deg": deg_for_file(value),
         "closed_form_deg": dict(zip("xyz", (closed / DEG).tolist())),
         "propagated_deg": {a: float(prop[a][-1] / DEG) for a in "xyz"},
         "note": ("one fixed-axis rotation: Eq 11-13 is exact" if man.fixed_axis else
                  "rotations about changing axes do not integrate as Eq 11-13; the propagated values are the truth"),
     }
-
-
-@dataclass(frozen=True, eq=False)
-class Margin(Value):
-    """One element of the budget-versus-allowance check.
-
-    Attributes
-    ----------
-    element : str
-    predicted : float
-        The budget's figure for the element, rad.
-    allowed : float
-        The allowance, rad (``inf``: unconstrained).
-    """
-
-    element: str
-    predicted: float
-    allowed: float
-
-    @property
-    def margin(self) -> float:
-        """``allowed - predicted``, rad."""
-        return self.allowed - self.predicted
-
-    @property
-    def ok(self) -> bool:
-        return self.predicted <= self.allowed
-
-
-def margins(predicted: dict, allow: Allowable) -> list[Margin]:
-    """Element by element: the predicted misalignment (rad) against the allowable one."""
-    missing = [e for e in ELEMENTS if e not in predicted]
-    if missing:
-        raise ValueError(f"no prediction for {missing}")
-    return [Margin(e, float(predicted[e]), float(allow.allowable[e])) for e in ELEMENTS]
-
-
-class MarginTable(Result, format="imu-align.check", convention=CONVENTION):
-    """The budget against the allowance, element by element (iterates over its rows).
-
-    Attributes
-    ----------
-    basis : str
-        Which budget figure was compared ("rss" or "worst").
-    rows : tuple of Margin
-        One per element, in :data:`~align.sensitivity.symbolic.ELEMENTS` order.
-    inputs : dict
-    """
-
-    basis: str
-    rows: tuple[Margin, ...]
-    inputs: dict = field(default_factory=dict)
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "rows", tuple(self.rows))
-        super().__post_init__()
-
-    def __iter__(self):
-        return iter(self.rows)
-
-    def __len__(self) -> int:
-        return len(self.rows)
-
-    @property
-    def passed(self) -> bool:
-        """Every element within its allowance."""
-        return all(r.ok for r in self.rows)
-
-    @property
-    def failed(self) -> list[str]:
-        """The elements over their allowance."""
-        return [r.element for r in self.rows if not r.ok]
-
-    def to_dict(self) -> dict:
-        """The versioned JSON form, angles in deg (``None`` for unconstrained)."""
-        return {
-            **self.envelope({"angles": "deg"}),
-            "basis": self.basis, "pass": self.passed,
-            "elements": [{"element": r.element, "predicted_deg": r.predicted / DEG, "allowed_deg": _deg(r.allowed),
-                          "margin_deg": _deg(r.margin), "pass": r.ok} for r in self.rows],
-            "inputs": dict(self.inputs),
-        }
-
-    @classmethod
-    def from_dict(cls, d: dict, where: str = "result") -> MarginTable:
-        """Read the form written by :meth:`to_dict`."""
-        cls.check_envelope(d, where)
-        try:
-            rows = tuple(Margin(str(r["element"]), _rad(r["predicted_deg"]), _rad(r["allowed_deg"]))
-                         for r in d["elements"])
-            return cls(str(d["basis"]), rows, dict(d.get("inputs", {})))
-        except (KeyError, TypeError, ValueError) as exc:
-            raise InputError(f"malformed check result ({exc!r}); regenerate it with imu-align check", where) from None
-
-
-def check_margins(budget_elements: dict, allow: Allowable, basis: str) -> MarginTable:
-    """The predicted budget against the allowance, element by element.
-
-    Parameters
-    ----------
-    budget_elements : dict
-        Element -> predicted size, rad (``mechanics.budget.Budget.elements(basis)``).
-    allow : Allowable
-    basis : str
-        The budget figure the prediction is ("rss" or "worst"), recorded in the table.
-
-    Returns
-    -------
-    MarginTable
-    """
-    return MarginTable(basis, tuple(margins(budget_elements, allow)))

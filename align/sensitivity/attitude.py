@@ -72,8 +72,10 @@ def output_errors(man: Manoeuvre, m: np.ndarray, history: bool = False) -> dict:
     Parameters
     ----------
     man : Manoeuvre
+        Its ``increments`` (n, 3), rad, body-frame rotation vectors, and its
+        ``limits`` (output name -> rad), which name the outputs computed.
     m : array_like, shape (3, 3)
-        The misaligned response ``M`` (Eq 5-10).
+        The misaligned response ``M`` (Eq 5-10), dimensionless.
     history : bool
         Return the full time histories of every output instead.
 
@@ -109,7 +111,9 @@ def closed_form_errors(man: Manoeuvre, m: np.ndarray) -> np.ndarray:
     Parameters
     ----------
     man : Manoeuvre
+        Its ``increments`` (n, 3), rad, each taken as a fixed-axis rotation.
     m : array_like, shape (3, 3)
+        The misaligned response ``M`` (Eq 5-10), dimensionless.
 
     Returns
     -------

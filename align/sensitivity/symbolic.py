@@ -23,6 +23,7 @@ from functools import lru_cache
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from align.errors import InputError
 from align.values import Value
@@ -33,6 +34,7 @@ ELEMENTS = ("psi_x", "psi_y", "psi_z", "phi_xy", "phi_xz", "phi_yx", "phi_yz", "
 OUTPUTS = ("x", "y", "z", "azimuth", "elevation", "roll")
 #: gyro / axis name -> index
 AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
+#: how :func:`symbolic_text` prints: sympy's ASCII pretty printer or LaTeX
 STYLES = ("pretty", "latex")
 
 
@@ -65,7 +67,14 @@ class Symbolic(Value):
 
 @lru_cache(maxsize=1)
 def symbolic() -> Symbolic:
-    """Derive Eq 5-13 and their sensitivities with sympy (cached)."""
+    """Derive Eq 5-13 and their sensitivities with sympy (cached).
+
+    Returns
+    -------
+    Symbolic
+        ``M`` in the nine angles (Eq 5-10), ``g = M w``, ``theta_G = M theta``
+        (Eq 11-13) and the Jacobian ``d g / d angles`` (3, 9).
+    """
     import sympy as sp
 
     ang = sp.symbols(" ".join(ELEMENTS), real=True)
@@ -88,6 +97,12 @@ def symbolic_text(style: str = "pretty") -> str:
     Returns
     -------
     str
+        The three equations, each after a heading line, separated by blank lines.
+
+    Raises
+    ------
+    InputError
+        For a style other than ``"pretty"`` or ``"latex"`` (names ``{style}``).
     """
     import sympy as sp
 
@@ -123,7 +138,7 @@ def _angle_vector(angles) -> np.ndarray:
     return np.asarray(angles, dtype=float).reshape(9)
 
 
-def matrix_from_angles(angles) -> np.ndarray:
+def matrix_from_angles(angles: dict[str, float] | npt.ArrayLike) -> np.ndarray:
     """``M`` of Eq 5-10 from the nine angles, via the lambdified sympy form.
 
     Parameters
@@ -135,11 +150,17 @@ def matrix_from_angles(angles) -> np.ndarray:
     Returns
     -------
     ndarray, shape (3, 3)
+        ``M_ii = cos(psi_i)``, ``M_ij = sin(phi_ij)``, dimensionless.
+
+    Raises
+    ------
+    InputError
+        For a dict naming an element not in :data:`ELEMENTS`.
     """
     return np.array(_lambdified()[0](tuple(_angle_vector(angles))), dtype=float)
 
 
-def response(w, angles) -> np.ndarray:
+def response(w: npt.ArrayLike, angles: dict[str, float] | npt.ArrayLike) -> np.ndarray:
     """Gyro outputs ``g = M w`` (Eq 5-10).
 
     Parameters
@@ -152,18 +173,20 @@ def response(w, angles) -> np.ndarray:
     Returns
     -------
     ndarray, shape like ``w``
+        The gyro outputs, in the unit of ``w``.
     """
     return np.asarray(w, float) @ matrix_from_angles(angles).T
 
 
-def sensitivity(w, angles) -> np.ndarray:
-    """Jacobian ``d g / d angles`` at rate ``w`` (lambdified sympy).
+def sensitivity(w: npt.ArrayLike, angles: dict[str, float] | npt.ArrayLike) -> np.ndarray:
+    """Jacobian ``d g / d angles`` of Eq 5-10 at rate ``w`` (lambdified sympy).
 
     Parameters
     ----------
     w : array_like, shape (3,)
+        True body rate (any unit; the Jacobian is in the same per rad).
     angles : dict or array_like, shape (9,)
-        rad.
+        As :func:`matrix_from_angles`, rad.
 
     Returns
     -------

@@ -5,11 +5,12 @@ import pytest
 from conftest import truth_model
 from scipy.spatial.transform import Rotation
 
-from align.alignment.estimate import Observation, fit_rate_pairs, two_axis_error_bound
+from align.alignment.estimate import Observation, fit_rate_pairs
 from align.alignment.job import AlignOptions, align
 from align.alignment.plan import Plan, Step
 from align.alignment.segment import Segment
 from align.alignment.simulate import SessionSpec, simulate_session
+from align.alignment.twoaxis import two_axis_error_bound
 from align.model import SensorModel
 from align.units import DEG
 from align.units import parse_quantity as q

@@ -4,6 +4,7 @@ import json
 
 import numpy as np
 import pytest
+from accelsim import six_faces
 from conftest import SHARED
 
 from align.calibration import accel_session, calibrate_accel
@@ -46,21 +47,9 @@ def test_accel_units_that_are_not_an_acceleration(run_cli):
     assert res.code == 2 and "acceleration" in res.err
 
 
-def _six_faces(m_true, b_true, g, n=200, rng=None):
-    """A log of the six faces (n samples each, separated by moves) and its positions list."""
-    rng = rng or np.random.default_rng(1)
-    blocks, positions = [], []
-    for i, a in enumerate("xyz"):
-        for s in (1, -1):
-            u = np.eye(3)[i] * s
-            blocks.append(m_true @ (g * u) + b_true + rng.normal(0, 1e-3, (n, 3)))
-            positions.append({"name": f"{'+' if s > 0 else '-'}{a}", "up": f"{'+' if s > 0 else '-'}{a}"})
-    return np.vstack(blocks), positions
-
-
 def test_accel_session_from_positions_and_its_errors():
     m_true, b_true, g, n = np.diag([1.01, 0.99, 1.0]), np.array([0.1, -0.2, 0.05]), 9.81, 200
-    a, positions = _six_faces(m_true, b_true, g, n)
+    a, positions = six_faces(m_true, b_true, g, n)
     t = np.arange(len(a)) / 100.0
     intervals = [(k * n, (k + 1) * n) for k in range(6)]
     cal = accel_session(t, a, intervals, positions, g, "m/s^2")

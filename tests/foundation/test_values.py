@@ -47,3 +47,13 @@ def test_errors_name_inputs_in_the_callers_terms():
     assert str(bad.value).startswith("axis_to_axis: 'mm' is not an angle")
     # user text with braces that are not placeholders is left alone
     assert str(InputError("bad value {'a': 1}", "f.json")) == "f.json: bad value {'a': 1}"
+
+
+def test_user_text_with_braces_is_never_read_as_a_placeholder():
+    from align.errors import literal
+
+    err = InputError("file not found", "/tmp/{run_a}/nope.csv")
+    assert err.render(lambda n, v: "--" + n) == "/tmp/{run_a}/nope.csv: file not found"
+    err = InputError(f"folder {literal('/x/{y}')} does not exist; set {{rate_hz=100}}", "{json_out}")
+    assert str(err) == "json_out: folder /x/{y} does not exist; set rate_hz='100'"
+    assert err.fields == ["json_out", "rate_hz"]

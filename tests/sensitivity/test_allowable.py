@@ -9,8 +9,9 @@ from conftest import ROOT
 
 from align.io import read_toml
 from align.results import load_result, save_result
-from align.sensitivity.allowable import Allowable, Margin, MarginTable, allowable, check_margins
-from align.sensitivity.manoeuvre import manoeuvre_from_dict
+from align.sensitivity.allowable import Allowable, allowable
+from align.sensitivity.manoeuvre import Manoeuvre, manoeuvre_from_dict
+from align.sensitivity.margins import Margin, MarginTable, check_margins
 from align.sensitivity.symbolic import ELEMENTS
 from align.units import DEG
 from align.values import approx_equal
@@ -130,3 +131,54 @@ def test_margin_table_round_trips_through_a_file(tmp_path):
     back = load_result(tmp_path / "c.json")
     assert type(back) is MarginTable and approx_equal(back, table, rtol=1e-12)
     assert back.rows[2].allowed == np.inf and back.inputs == {"mount": "m.toml"}
+
+
+def test_rotation_manoeuvre_keeps_its_increments_in_the_file(example2):
+    d = example2.to_dict()["manoeuvre_detail"]
+    assert example2.series is None and "series" not in d
+    assert np.allclose(d["increments_deg"], [[0.0, 0.0, 30.0]], rtol=1e-12)
+
+
+def _series_manoeuvre(tmp_path):
+    """A 300-sample rate series: a smooth 38 deg turn about z with some x (changing axis)."""
+    t = np.arange(0, 3.0, 0.01)
+    rate = 20.0 * np.sin(np.pi * t / 3.0)
+    (tmp_path / "rates.csv").write_text("time,wx,wy,wz\n" + "\n".join(
+        f"{a:.6f},{0.2 * r:.9f},0,{r:.9f}" for a, r in zip(t, rate)) + "\n")
+    return manoeuvre_from_dict({"series": {"file": "rates.csv"}, "limits": {"y": "1 deg", "z": "1 deg"}}, "m", tmp_path)
+
+
+def test_series_allowable_writes_a_summary_not_the_samples_and_round_trips(tmp_path):
+    man = _series_manoeuvre(tmp_path)
+    a = allowable(man, directions=20).replace(inputs={"manoeuvre": "m.toml"})
+    d = a.to_dict()
+    detail = d["manoeuvre_detail"]
+    assert "increments_deg" not in detail
+    assert set(detail) >= {"description", "limits_deg", "fixed_axis", "segments", "series"}
+    assert detail["limits_deg"] == pytest.approx({"y": 1.0, "z": 1.0}, rel=1e-12) and detail["segments"] == []
+    s = detail["series"]
+    assert s["samples"] == 300 and s["increments"] == 299 and len(s["increments_sha256"]) == 64
+    assert s["increments_sum_deg"] == pytest.approx(man.increments.sum(axis=0) / DEG, rel=1e-12)
+    assert a.series == s
+    # read back: everything but the samples; the file it writes again is the file it was read from
+    back = Allowable.from_dict(d)
+    assert back.manoeuvre.increments.shape == (0, 3) and back.series == a.series
+    assert approx_equal(back, a.replace(manoeuvre=man.replace(increments=np.empty((0, 3)))), rtol=1e-12)
+    assert approx_equal(back.to_dict(), d, rtol=1e-12)
+    save_result(tmp_path / "a.json", a)
+    loaded = load_result(tmp_path / "a.json")
+    assert type(loaded) is Allowable and approx_equal(loaded, back, rtol=1e-12)
+    assert approx_equal(loaded.to_dict(), json.loads((tmp_path / "a.json").read_text()), rtol=1e-12)
+
+
+def test_a_long_series_stays_a_small_file():
+    """200 000 samples used to be written one by one (11 MB); the summary is a few hundred bytes."""
+    inc = np.random.default_rng(0).normal(0.0, 1e-4, (200_000, 3))
+    man = Manoeuvre(inc, {"y": 1 * DEG}, description="rate series long.csv: 200001 samples")
+    a = Allowable({e: 0.01 for e in ELEMENTS}, {e: "numeric (attitude propagation)" for e in ELEMENTS}, "psi_x", 0.01,
+                  0.02, np.array([0.0, 0.0, 1.0]), {}, man)
+    text = json.dumps(a.to_dict())
+    assert len(text) < 4000
+    other = a.replace(manoeuvre=man.replace(increments=inc[::-1]))   # the same numbers in another order
+    assert other.to_dict()["manoeuvre_detail"]["series"]["increments_sha256"] != json.loads(text)[
+        "manoeuvre_detail"]["series"]["increments_sha256"]
