@@ -161,6 +161,9 @@ def _usage_message(exc: Exception, path: list[str], args: list[str]) -> str:
     text = text.removeprefix("Value error, ").rstrip(".")
     if "BadParameter" in kinds and param is not None:
         given = _given(param, args)
+        cause = exc.__cause__ or exc.__context__  # typer < 0.27 keeps the parser's reason only there
+        if (not text or text == given) and isinstance(cause, ValueError) and str(cause):
+            text = " ".join(str(cause).split()).removeprefix("Value error, ").rstrip(".")
         if given is None or repr(given) in text:
             return f"invalid value for {_flag(param)}: {text}"
         return f"invalid value {given!r} for {_flag(param)}" + ("" if text == given else f": {text}")
