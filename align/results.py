@@ -23,6 +23,7 @@ Result, Correction, KNOWN, register, envelope, file_unit, load_result, result_fr
 from __future__ import annotations
 
 import importlib
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar, Protocol, dataclass_transform
@@ -32,6 +33,7 @@ import numpy as np
 from align import __version__
 from align.errors import InputError
 from align.io.files import read_json, write_json
+from align.io.keys import check_keys
 from align.plausible import check_usable_model
 from align.units import parse_unit
 from align.values import Value
@@ -50,6 +52,8 @@ KNOWN: dict[str, str] = {
 }
 
 _TYPES: dict[str, type[Result]] = {}
+#: the first keys of every result file
+ENVELOPE_KEYS = ("format", "version", "generator", "convention", "units")
 
 
 class Correction(Protocol):
@@ -124,8 +128,9 @@ class Result(Value):
         return envelope(self.FORMAT, self.VERSION, self.CONVENTION, units)
 
     @classmethod
-    def check_envelope(cls, d: Any, where: str = "result") -> None:
-        """Refuse a dictionary that is not this type's format, or a newer version of it."""
+    def check_envelope(cls, d: Any, where: str = "result", keys: Iterable[str] | None = None) -> None:
+        """Refuse a dictionary that is not this type's format, or a newer version of it, and (with
+        ``keys``, the body's keys) one holding a key neither the envelope nor the body knows."""
         if not isinstance(d, dict):
             raise InputError("expected a JSON object", where)
         if d.get("format") != cls.FORMAT:
@@ -136,6 +141,8 @@ class Result(Value):
         if version > cls.VERSION:
             raise InputError(f"{cls.FORMAT} version {version} is newer than this imu-align {__version__} reads "
                              f"(up to {cls.VERSION}); upgrade imu-align", where)
+        if keys is not None:
+            check_keys(d, [*ENVELOPE_KEYS, *keys], where)
 
     def correction(self, sensor: str | None = None, where: str = "result") -> Correction:
         """What corrects a log of ``sensor`` (the only sensor when None); results that correct nothing refuse.

@@ -27,9 +27,8 @@ import numpy as np
 
 from align import CONVENTION
 from align.errors import InputError
-from align.io.keys import check_keys
 from align.plausible import malformed
-from align.results import Result, envelope
+from align.results import Result
 from align.units import DEG
 from mechanics.assembly import skew_limit, worst_case_per_axis
 from mechanics.formulas import rss, screw_radius, skew_from_screws, tilt_from_ledges
@@ -153,8 +152,7 @@ class Budget(Result, format=FORMAT, convention=BUDGET_CONVENTION):
     @classmethod
     def from_dict(cls, d: dict, where: str = "result") -> Budget:
         """Read the form written by :meth:`to_dict`; a key it does not know is refused (a misspelling)."""
-        cls.check_envelope(d, where)
-        check_keys(d, [*envelope(cls.FORMAT, cls.VERSION, cls.CONVENTION), *FILE_KEYS], where)
+        cls.check_envelope(d, where, keys=FILE_KEYS)
         try:
             mc = d.get("monte_carlo")
             return cls(

@@ -32,10 +32,9 @@ from align.alignment.twoaxis import two_axis, two_axis_error_bound
 from align.earth import EARTH_RATE, vertical_rate
 from align.errors import InputError
 from align.io import c_header, check_log
-from align.io.keys import check_keys
 from align.model import Angles, SensorModel, angles, check_handedness
 from align.plausible import array_field, malformed
-from align.results import Result, envelope, file_unit
+from align.results import Result, file_unit
 from align.units import DEG, DEG_H, parse_unit, to_unit
 from align.values import Value
 
@@ -93,6 +92,11 @@ class SegmentReport(Value):
     t_end: float
     residual: tuple[float, float, float]
     noise: tuple[float, float, float]
+
+
+#: the keys of an alignment result file after the envelope
+FILE_KEYS = ("sensor", "method", "M", "A", "bias", "uncertainty", "angles", "condition_number", "dof", "inferred_axis",
+             "segments", "checks", "notes", "inputs")
 
 
 class AlignmentResult(Result, format=FORMAT, version=FORMAT_VERSION, convention=CONVENTION):
@@ -195,10 +199,7 @@ class AlignmentResult(Result, format=FORMAT, version=FORMAT_VERSION, convention=
     @classmethod
     def from_dict(cls, d: dict, where: str = "result") -> AlignmentResult:
         """Read the form written by :meth:`to_dict` (any version up to the current one)."""
-        cls.check_envelope(d, where)
-        known = ("sensor", "method", "M", "A", "bias", "uncertainty", "angles", "condition_number", "dof", "inferred_axis",
-                 "segments", "checks", "notes", "inputs")  # after the envelope; a misspelled key is refused, not ignored
-        check_keys(d, [*envelope(cls.FORMAT, cls.VERSION, cls.CONVENTION), *known], where)
+        cls.check_envelope(d, where, keys=FILE_KEYS)  # a misspelled key is refused, not ignored
         try:
             u, f = file_unit(d, "bias", "angular_rate", where)
             m = array_field(d, "M", (3, 3), "alignment result", where)

@@ -22,10 +22,9 @@ from align import CONVENTION
 from align.alignment.plan import Plan
 from align.earth import earth_rate_in_frame
 from align.errors import InputError
-from align.io.keys import check_keys
 from align.model import SensorModel
 from align.plausible import malformed
-from align.results import Result, envelope, file_unit
+from align.results import Result, file_unit
 from align.units import DEG, DEG_S, to_unit
 
 
@@ -229,8 +228,7 @@ class SimulationTruth(Result, format="imu-align.truth", convention=CONVENTION):
 
     @classmethod
     def from_dict(cls, d: dict, where: str = "truth") -> SimulationTruth:
-        cls.check_envelope(d, where)
-        check_keys(d, [*envelope(cls.FORMAT, cls.VERSION, cls.CONVENTION), "M", "A", "bias", "seed", "inputs"], where)
+        cls.check_envelope(d, where, keys=["M", "A", "bias", "seed", "inputs"])
         try:
             u, f = file_unit(d, "bias", "angular_rate", where)
             return cls(SensorModel(np.array(d["M"], float), np.array(d["bias"], float) * f), u, d.get("seed"),

@@ -31,7 +31,6 @@ import numpy as np
 from align.calibration.ellipsoid import MODELS, algebraic_fit, pack, unpack
 from align.errors import InputError, TestError, literal
 from align.io import check_finite
-from align.io.keys import check_keys
 from align.plausible import (
     array_field,
     check_dip,
@@ -40,7 +39,7 @@ from align.plausible import (
     check_positive_definite,
     malformed,
 )
-from align.results import Result, envelope, file_unit
+from align.results import Result, file_unit
 from align.units import DEG, to_unit
 
 FORMAT = "imu-align.magnetometer"
@@ -144,8 +143,7 @@ class MagCalibration(Result, format=FORMAT, convention=CONVENTION):
     @classmethod
     def from_dict(cls, d: dict, where: str = "magnetometer") -> MagCalibration:
         """Read the form written by :meth:`to_dict` (any version up to the current one)."""
-        cls.check_envelope(d, where)
-        check_keys(d, [*envelope(cls.FORMAT, cls.VERSION, cls.CONVENTION), *FILE_KEYS], where)
+        cls.check_envelope(d, where, keys=FILE_KEYS)
         try:
             u, f = file_unit(d, "hard_iron", None, where)
             q = d["quality"]

@@ -23,7 +23,7 @@ from align.errors import InputError
 from align.io.export import imucal_dict
 from align.io.keys import check_keys
 from align.plausible import array_field, check_usable_model, malformed
-from align.results import Result, envelope, file_unit
+from align.results import Result, file_unit
 from align.units import to_unit
 from align.values import Value, frozen_array
 
@@ -170,8 +170,7 @@ class CalibrationSet(Result, format=FORMAT, convention=CONVENTION):
     @classmethod
     def from_dict(cls, d: dict, where: str = "calibration") -> CalibrationSet:
         """Read the form written by :meth:`to_dict` (any version up to the current one)."""
-        cls.check_envelope(d, where)
-        check_keys(d, [*envelope(cls.FORMAT, cls.VERSION, cls.CONVENTION), "inputs", *SENSORS], where)
+        cls.check_envelope(d, where, keys=["inputs", *SENSORS])
         sensors = {k: Calibration.from_dict(d[k], f"{where}: {k}") for k in SENSORS if k in d}
         if not sensors:
             raise InputError(f"holds no {' or '.join(SENSORS)} calibration", where)

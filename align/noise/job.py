@@ -20,13 +20,12 @@ from typing import Any
 import numpy as np
 
 from align.errors import InputError
-from align.io.keys import check_keys
 from align.noise.allan import NOISE_ALPHA, AllanResult, allan, edf_overlapping
 from align.noise.fit import NoiseFit, fit_noise
 from align.noise.model import TERMS, avar_design
 from align.noise.planner import PlanResult, make_plan
 from align.plausible import malformed
-from align.results import Result, envelope, file_unit
+from align.results import Result, file_unit
 from align.units import parse_unit, to_unit
 
 FORMAT = "imu-align.allan"
@@ -156,8 +155,7 @@ class AllanJob(Result, format=FORMAT, convention=CONVENTION):
     def from_dict(cls, d: dict[str, Any], where: str = "result") -> AllanJob:
         """Read the form written by :meth:`to_dict` (files written before ``m``, ``edf``,
         ``dominant`` and ``adev_run_figures`` were added read too: those are rebuilt)."""
-        cls.check_envelope(d, where)
-        check_keys(d, [*envelope(cls.FORMAT, cls.VERSION, cls.CONVENTION), *FILE_KEYS], where)
+        cls.check_envelope(d, where, keys=FILE_KEYS)
         try:
             u, f = file_unit(d, "adev", None, where)
             tu = term_units(u)

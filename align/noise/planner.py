@@ -22,11 +22,10 @@ from typing import Any
 import numpy as np
 
 from align.errors import InputError
-from align.io.keys import check_keys
 from align.noise.model import NoiseModel
 from align.parts import Part
 from align.plausible import malformed
-from align.results import Result, envelope
+from align.results import Result
 from align.units import DEG, DEG_H
 from align.values import Value
 
@@ -198,8 +197,7 @@ class PlanResult(Result, format=FORMAT, convention=CONVENTION):
     @classmethod
     def from_dict(cls, d: dict[str, Any], where: str = "result") -> PlanResult:
         """Read the form written by :meth:`to_dict`; a key it does not know is refused (a misspelling)."""
-        cls.check_envelope(d, where)
-        check_keys(d, [*envelope(cls.FORMAT, cls.VERSION, cls.CONVENTION), *FILE_KEYS], where)
+        cls.check_envelope(d, where, keys=FILE_KEYS)
         try:
             am, tp = d["angle_method"], d["test_plan"]
             tau = d["averaging_time_s"]
