@@ -15,7 +15,7 @@ axis (a flipped axis or swapped positions is a handedness error).
 Public names
 ------------
 check_gravity, check_at_rest, check_field_strength, check_known_field, check_corrected, check_dip, check_axes,
-check_scale_factors,
+check_scale_factors, scale_outside,
 check_usable_model, check_positive_definite, require_finite, array_field, malformed, mixup_hint,
 ACCELERATION_UNITS, FIELD_UNITS, GRAVITY_RANGE, EARTH_FIELD, FIELD_RANGE, AT_REST_RANGE, MAX_CONDITION
 """
@@ -311,10 +311,20 @@ def check_scale_factors(m: np.ndarray, tolerance: float, units: str, expect: str
     """
     if _declared_factor(units, expect) is None:
         return
+    bad = scale_outside(m, tolerance)
+    if bad is not None:
+        i, s = bad
+        raise TestError(f"{AXES[i]} scale factor {_num(s)} is outside 1 +/- {tolerance:g}: wrong {{{field}}}, "
+                        "wrong columns, or a broken axis", where)
+
+
+def scale_outside(m: np.ndarray, tolerance: float) -> tuple[int, float] | None:
+    """The first row whose scale factor ``|M[i, :]|`` (reference section 1) is not within ``1 +/- tolerance``
+    (NaN included), as ``(i, scale)``; None when every row is."""
     for i, s in enumerate(np.linalg.norm(m, axis=1)):
         if not abs(s - 1.0) <= tolerance:
-            raise TestError(f"{AXES[i]} scale factor {_num(s)} is outside 1 +/- {tolerance:g}: wrong {{{field}}}, "
-                            "wrong columns, or a broken axis", where)
+            return i, float(s)
+    return None
 
 
 def require_finite(where: str, what: str, **arrays: np.ndarray | None) -> None:

@@ -20,6 +20,7 @@ import numpy as np
 from align.alignment.plan import Plan, axis_name
 from align.alignment.segment import Segment
 from align.errors import HandednessError, TestError
+from align.plausible import scale_outside
 from align.units import format_quantity, unit_mixup_hint
 from align.values import Value
 
@@ -270,13 +271,14 @@ def check_scale(m: np.ndarray, tolerance: float, where: str = "result") -> Check
         For the first gyro whose scale factor is outside the band (or NaN).
     """
     scale = np.linalg.norm(m, axis=1)
-    for i, s in enumerate(scale):
-        if not abs(s - 1.0) <= tolerance:
-            raise TestError(
-                f"gyro {'xyz'[i]} scale factor {s:.4f} is outside 1 +/- {tolerance:g}: wrong gyro units, "
-                "wrong table rate, or a broken gyro (raise {scale_tolerance} if this is expected)",
-                where,
-            )
+    bad = scale_outside(m, tolerance)
+    if bad is not None:
+        i, s = bad
+        raise TestError(
+            f"gyro {'xyz'[i]} scale factor {s:.4f} is outside 1 +/- {tolerance:g}: wrong gyro units, "
+            "wrong table rate, or a broken gyro (raise {scale_tolerance} if this is expected)",
+            where,
+        )
     return Check("scale", "pass", f"scale factors {', '.join(f'{s:.5f}' for s in scale)} within 1 +/- {tolerance:g}")
 
 
