@@ -39,7 +39,7 @@ from typing import Annotated
 import typer
 
 from align import __version__
-from align.cli import alignment, calibrate, mechanics, noise, story
+from align.cli import alignment, calibrate, mechanics, noise, simulate, story
 from align.cli.options import rewrite_aliases, speller
 
 PROG = "imu-align"
@@ -68,14 +68,14 @@ def _root(
     pass
 
 
-for _module in (alignment, mechanics, noise, story):
+for _module in (alignment, simulate, mechanics, noise, story):
     for _name, _command in _module.COMMANDS.items():
         app.command(_name)(_command)
 app.add_typer(calibrate.app, name="calibrate")
 
 #: command -> its subcommands (empty: a command)
 COMMANDS: dict[str, tuple[str, ...]] = {
-    **{name: () for m in (alignment, mechanics, noise, story) for name in m.COMMANDS},
+    **{name: () for m in (alignment, simulate, mechanics, noise, story) for name in m.COMMANDS},
     "calibrate": tuple(calibrate.COMMANDS),
 }
 

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from align.errors import InputError
+from align.flicker import flicker_fft, flicker_gm
 from align.noise.fit import noise_figures
 from align.noise.model import NoiseModel
 from align.values import Value
@@ -70,39 +71,6 @@ def _rng(seed) -> np.random.Generator:
     return seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
 
 
-def _flicker_fft(n: int, fs: float, b: float, rng: np.random.Generator, channels: int) -> np.ndarray:
-    """1/f rate noise of one-sided PSD ``b^2 / (pi f)`` by spectral synthesis."""
-    k = np.arange(1, n // 2 + 1)
-    f = k * fs / n
-    amp = np.sqrt(b**2 / (np.pi * f) * n * fs / 4.0)
-    out = np.empty((n, channels))
-    for c in range(channels):
-        spec = np.zeros(n // 2 + 1, dtype=complex)
-        spec[1:] = amp * (rng.standard_normal(len(k)) + 1j * rng.standard_normal(len(k)))
-        if n % 2 == 0:
-            spec[-1] = spec[-1].real * np.sqrt(2.0)  # the Nyquist bin is real
-        out[:, c] = np.fft.irfft(spec, n)
-    return out
-
-
-def _flicker_gm(n: int, fs: float, b: float, rng: np.random.Generator, channels: int, bank: int) -> np.ndarray:
-    """1/f approximated by Gauss-Markov processes, equal variance per log-step of correlation time."""
-    from scipy.signal import lfilter
-
-    dt = 1.0 / fs
-    t_lo, t_hi = 5 * dt, n * dt / 2
-    times = np.geomspace(t_lo, t_hi, bank)
-    step = np.log(times[1] / times[0]) if bank > 1 else 1.0
-    sigma = np.sqrt(b**2 / np.pi * step)  # sum_j 4 sigma^2 T_j / (1 + (2 pi f T_j)^2) ~ sigma^2 / (step f)
-    out = np.zeros((n, channels))
-    for t in times:
-        phi = np.exp(-dt / t)
-        w = rng.standard_normal((n, channels)) * sigma * np.sqrt(1 - phi**2)
-        w[0] = rng.standard_normal(channels) * sigma  # start in the stationary state
-        out += lfilter([1.0], [1.0, -phi], w, axis=0)
-    return out
-
-
 def simulate_noise(n: int, fs: float, spec: NoiseSpec, channels: int = 1, seed=0) -> np.ndarray:
     """Sensor error samples, shape (n, channels), for a static or moving run (see module docstring)."""
     rng = _rng(seed)
@@ -112,9 +80,9 @@ def simulate_noise(n: int, fs: float, spec: NoiseSpec, channels: int = 1, seed=0
         e = e + rng.standard_normal((n, channels)) * spec.white * np.sqrt(fs)
     if spec.flicker:
         if spec.flicker_model == "fft":
-            e = e + _flicker_fft(n, fs, spec.flicker, rng, channels)
+            e = e + flicker_fft(n, fs, spec.flicker, rng, channels)
         else:
-            e = e + _flicker_gm(n, fs, spec.flicker, rng, channels, spec.flicker_bank)
+            e = e + flicker_gm(n, fs, spec.flicker, rng, channels, spec.flicker_bank)
     if spec.random_walk:
         e = e + np.cumsum(rng.standard_normal((n, channels)), axis=0) * spec.random_walk * np.sqrt(dt)
     if spec.quantization:
