@@ -25,9 +25,10 @@ from align.alignment.checks import (
     check_scale,
     check_span,
 )
-from align.alignment.estimate import alignment_sigma, fit_angle_pairs, fit_lsq, fit_rate_pairs, observe
+from align.alignment.estimate import alignment_sigma, fit_angle_pairs, fit_lsq, fit_rate_pairs
+from align.alignment.observe import observe
 from align.alignment.plan import Plan
-from align.alignment.segment import Segment, SegmentOptions, noise_sigma, segment_log
+from align.alignment.segment import Motion, Segment, SegmentOptions, noise_sigma, segment_log
 from align.alignment.twoaxis import two_axis, two_axis_error_bound
 from align.earth import EARTH_RATE, vertical_rate
 from align.errors import InputError
@@ -121,6 +122,9 @@ class AlignmentResult(Result, format=FORMAT, version=FORMAT_VERSION, convention=
     units: str = "deg/s"
     inferred_axis: int | None = None
     inputs: dict = field(default_factory=dict)
+    mounting: np.ndarray = field(default_factory=lambda: np.eye(3))
+    mounting_source: str = "identity"
+    motions: tuple[Motion, ...] = ()
 
 
     @property

@@ -5,6 +5,13 @@ rate (``rate``, Eq 19-30) or through a signed angle (``angle``, Eq 31).
 ``axis = "-y"`` means the system's -y axis points along the table's spin axis;
 a positive rate or angle is a right-handed turn about that axis.
 
+The geometry (frames in :mod:`align.alignment.geometry`): ``[test] table_axis`` is the direction of the
+table's positive spin axis in the local level frame (``"up"`` by default, or ``"down"``, ``"north"``,
+``"south"``, ``"east"``, ``"west"``); ``[test] rest = ["north", "west", "up"]`` says where system x, y, z
+point when the table is at rest before a step. Both may be overridden in a ``[[step]]`` (a fixture
+re-mounted between axes). ``[mounting]`` states the IMU's nominal mounting in the system
+(``axes = ["+y", "-x", "+z"]`` or ``matrix = [[...], [...], [...]]``).
+
 Public names
 ------------
 Step, Plan, parse_axis, axis_name, check_turn, PLAN_KEYS, TEST_KEYS, STEP_KEYS, MAX_RATE_DEG_S, MAX_ANGLE_DEG
@@ -17,6 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from align.alignment.geometry import direction, mounting_axes, parse_mounting, rest_matrix
 from align.errors import InputError, literal
 from align.io.keys import check_keys, table, tables
 from align.units import DEG, DEG_S, format_quantity, parse_quantity
@@ -52,12 +60,28 @@ class Step:
         Signed table rate, rad/s (rate steps).
     angle : float or None
         Signed table angle, rad (angle steps).
+    table_axis : str
+        Direction of the table's positive spin axis in the local level frame (``"up"``, ``"east"``, ...).
+    rest : tuple of 3 str, or None
+        Where system x, y, z point at rest before the step (ENU directions); None when not stated.
     """
 
     axis: int
     sign: int
     rate: float | None = None
     angle: float | None = None
+    table_axis: str = "up"
+    rest: tuple[str, str, str] | None = None
+
+    @property
+    def table_vector(self) -> np.ndarray:
+        """The table's positive spin axis, unit vector in the local level frame (ENU)."""
+        return direction(self.table_axis, "step")
+
+    @property
+    def rest_matrix(self) -> np.ndarray | None:
+        """``C`` (3, 3), system axes (columns) in ENU at rest before the step, or None when not stated."""
+        return None if self.rest is None else rest_matrix(list(self.rest), "step")
 
     @property
     def kind(self) -> str:
@@ -90,12 +114,26 @@ class Plan:
         Relative table-rate accuracy (1 sigma), added to the uncertainty of ``M``.
     angle_accuracy : float
         Table angle accuracy (1 sigma), rad, for angle steps.
+    mounting : tuple of tuples, or None
+        The declared nominal mounting ``N`` (rows: each gyro's nominal axis in the system frame), or None.
+    table_axis : str
+        The session's table axis (each step holds its own, which may differ).
+    rest : tuple of 3 str, or None
+        The session's rest orientation (each step holds its own).
     """
 
     steps: tuple[Step, ...]
     latitude: float | None = None
     rate_accuracy: float = 0.0
     angle_accuracy: float = 0.0
+    mounting: tuple[tuple[float, float, float], ...] | None = None
+    table_axis: str = "up"
+    rest: tuple[str, str, str] | None = None
+
+    @property
+    def nominal(self) -> np.ndarray | None:
+        """The declared nominal mounting ``N`` (3, 3), or None."""
+        return None if self.mounting is None else np.array(self.mounting, float)
 
     @property
     def kind(self) -> str:
@@ -110,17 +148,23 @@ class Plan:
         """Build a plan from the parsed TOML (see module docstring).
 
         Every table is checked for unknown keys (:data:`PLAN_KEYS`, :data:`TEST_KEYS`,
-        :data:`STEP_KEYS`); every value for its domain (a step turns the table: a
+        :data:`STEP_KEYS`, ``[mounting]``); every value for its domain (a step turns the table: a
         finite, non-zero rate or angle; ``|latitude| <= 90 deg``; accuracies finite,
-        not negative, ``rate_accuracy`` under 100 %).
+        not negative, ``rate_accuracy`` under 100 %; at rest, the step's axis points along the table axis).
         """
         check_keys(data, PLAN_KEYS, where)
         raw = tables(data, "step", where)
         if not raw:
             raise InputError("no [[step]] tables: list the table steps in the order they were run", where)
-        steps = tuple(_step(item, f"{where}: step {k}") for k, item in enumerate(raw, start=1))
         test = table(data, "test", where)
         check_keys(test, TEST_KEYS, f"{where}: [test]")
+        table_axis = _table_axis(test, "up", f"{where}: test.table_axis")
+        rest = _rest(test, None, f"{where}: test.rest")
+        steps = tuple(_step(item, f"{where}: step {k}", table_axis, rest) for k, item in enumerate(raw, start=1))
+        mounting = None
+        if "mounting" in data:
+            n = parse_mounting(table(data, "mounting", where), f"{where}: mounting")
+            mounting = tuple(tuple(float(v) for v in row) for row in n)
         lat = test.get("latitude")
         latitude = None if lat is None else parse_quantity(lat, "angle", f"{where}: test.latitude")
         if latitude is not None and abs(latitude) > np.pi / 2:
@@ -130,18 +174,29 @@ class Plan:
             raise InputError(f"{format_quantity(rate_acc, '%', 4)} is not a table-rate accuracy: it must be under "
                              "100 % (e.g. \"0.01 %\")", f"{where}: test.rate_accuracy")
         angle_acc = _accuracy(test, "angle_accuracy", "angle", "0 deg", where)
-        return cls(steps, latitude, rate_acc, angle_acc)
+        return cls(steps, latitude, rate_acc, angle_acc, mounting, table_axis, rest)
 
     def to_toml(self) -> str:
         """The plan as TOML text that :meth:`from_dict` reads back."""
         lines = []
-        if self.latitude is not None or self.rate_accuracy or self.angle_accuracy:
-            lines.append("[test]")
-            if self.latitude is not None:
-                lines.append(f'latitude = "{format_quantity(self.latitude, "deg", 10)}"')
-            lines.append(f'rate_accuracy = "{format_quantity(self.rate_accuracy, "%", 10)}"')
-            lines.append(f'angle_accuracy = "{format_quantity(self.angle_accuracy, "deg", 10)}"')
+        if self.mounting is not None:
+            axes = mounting_axes(self.nominal)
+            lines.append("[mounting]")
+            if axes is not None:
+                lines.append("axes = [" + ", ".join(f'"{a}"' for a in axes) + "]")
+            else:
+                lines.append("matrix = [" + ", ".join("[" + ", ".join(repr(float(v)) for v in row) + "]"
+                                                      for row in self.mounting) + "]")
             lines.append("")
+        lines.append("[test]")
+        if self.latitude is not None:
+            lines.append(f'latitude = "{format_quantity(self.latitude, "deg", 10)}"')
+        lines.append(f'rate_accuracy = "{format_quantity(self.rate_accuracy, "%", 10)}"')
+        lines.append(f'angle_accuracy = "{format_quantity(self.angle_accuracy, "deg", 10)}"')
+        lines.append(f'table_axis = "{self.table_axis}"')
+        if self.rest is not None:
+            lines.append("rest = [" + ", ".join(f'"{d}"' for d in self.rest) + "]")
+        lines.append("")
         for s in self.steps:
             lines.append("[[step]]")
             lines.append(f'axis = "{axis_name(s.axis, s.sign)}"')
@@ -149,6 +204,10 @@ class Plan:
                 lines.append(f'rate = "{format_quantity(s.rate, "deg/s", 12)}"')
             else:
                 lines.append(f'angle = "{format_quantity(s.angle, "deg", 12)}"')
+            if s.table_axis != self.table_axis:
+                lines.append(f'table_axis = "{s.table_axis}"')
+            if s.rest is not None and s.rest != self.rest:
+                lines.append("rest = [" + ", ".join(f'"{d}"' for d in s.rest) + "]")
             lines.append("")
         return "\n".join(lines)
 
@@ -168,15 +227,31 @@ class Plan:
 
 
 #: the keys of a plan file, of its [test] table and of each [[step]]
-PLAN_KEYS = ("test", "step")
-TEST_KEYS = ("latitude", "rate_accuracy", "angle_accuracy")
-STEP_KEYS = ("axis", "rate", "angle")
+PLAN_KEYS = ("test", "step", "mounting")
+TEST_KEYS = ("latitude", "rate_accuracy", "angle_accuracy", "table_axis", "rest")
+STEP_KEYS = ("axis", "rate", "angle", "table_axis", "rest")
 #: the largest table rate (deg/s) and turn (deg) a step may ask for: beyond, the number or unit is wrong
 MAX_RATE_DEG_S, MAX_ANGLE_DEG = 1e5, 1e5
 
 
-def _step(item: dict, here: str) -> Step:
-    """One ``[[step]]`` table; ``here`` names it ("plan.toml: step 3")."""
+def _table_axis(source: dict, default: str, where: str) -> str:
+    """The table-axis direction of ``[test]`` or a step (a direction name, lower case)."""
+    if "table_axis" not in source:
+        return default
+    direction(source["table_axis"], where)
+    return str(source["table_axis"]).strip().lower()
+
+
+def _rest(source: dict, default: tuple[str, str, str] | None, where: str) -> tuple[str, str, str] | None:
+    """The rest orientation of ``[test]`` or a step: three directions, checked (perpendicular, right-handed)."""
+    if "rest" not in source:
+        return default
+    rest_matrix(source["rest"], where)
+    return tuple(str(d).strip().lower() for d in source["rest"])
+
+
+def _step(item: dict, here: str, table_axis: str = "up", rest: tuple[str, str, str] | None = None) -> Step:
+    """One ``[[step]]`` table; ``here`` names it ("plan.toml: step 3"); ``table_axis`` and ``rest`` the session's."""
     check_keys(item, STEP_KEYS, here)
     if "axis" not in item:
         raise InputError("missing 'axis' (e.g. axis = \"+x\")", here)
@@ -184,11 +259,24 @@ def _step(item: dict, here: str) -> Step:
     has_rate, has_angle = "rate" in item, "angle" in item
     if has_rate == has_angle:
         raise InputError("give exactly one of 'rate' (e.g. \"100 deg/s\") or 'angle' (e.g. \"-360 deg\")", here)
+    table_axis = _table_axis(item, table_axis, f"{here}.table_axis")
+    rest = _rest(item, rest, f"{here}.rest")
+    if rest is not None and rest_matrix(list(rest), here)[:, axis] @ direction(table_axis, here) * sign < 0.5:
+        raise InputError(f"at rest system {axis_name(axis, sign)} points {_pointing(rest, axis, sign)}, not along the "
+                         f"table axis ({table_axis}): the step's axis must point along the table's spin axis; check "
+                         "'rest', 'table_axis' or 'axis'", here)
     if has_rate:
         rate = check_turn(parse_quantity(item["rate"], "angular_rate", f"{here}.rate"), "rate", f"{here}.rate")
-        return Step(axis, sign, rate=rate)
+        return Step(axis, sign, rate=rate, table_axis=table_axis, rest=rest)
     angle = check_turn(parse_quantity(item["angle"], "angle", f"{here}.angle"), "angle", f"{here}.angle")
-    return Step(axis, sign, angle=angle)
+    return Step(axis, sign, angle=angle, table_axis=table_axis, rest=rest)
+
+
+_OPPOSITE = {"east": "west", "west": "east", "north": "south", "south": "north", "up": "down", "down": "up"}
+
+
+def _pointing(rest: tuple[str, str, str], axis: int, sign: int) -> str:
+    return rest[axis] if sign > 0 else _OPPOSITE[rest[axis]]
 
 
 def check_turn(value: float, kind: str, where: str) -> float:

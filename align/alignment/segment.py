@@ -9,7 +9,7 @@ plateaus. Everything here works on SI arrays and never reads files.
 
 Public names
 ------------
-Segment, SegmentOptions, noise_sigma, find_plateaus, integrate, segment_log, segments_from_ranges,
+Segment, Motion, SegmentOptions, noise_sigma, find_plateaus, integrate, segment_log, segments_from_ranges,
 static_intervals
 """
 
@@ -42,6 +42,44 @@ class Segment:
     @property
     def n(self) -> int:
         return self.end - self.start
+
+
+@dataclass(frozen=True)
+class Motion:
+    """A motion in the log that no plan step claimed (a fixture re-orientation, a stop and restart, ...).
+
+    Attributes
+    ----------
+    name : str
+        ``"motion 1"``, ...
+    kind : str
+        ``"rate"`` (a constant-rate plateau) or ``"turn"`` (the motion between two static periods).
+    start, end : int
+        Samples (end exclusive).
+    t_start, t_end : float
+        s.
+    value : float
+        Size: rad/s for a plateau, rad for a turn.
+    axis : tuple of 3 float
+        Unit vector of the motion's axis in the system frame (through the estimated ``A``).
+    label : str
+        For people, e.g. ``"about +z at 20.0 deg/s"``.
+    """
+
+    name: str
+    kind: str
+    start: int
+    end: int
+    t_start: float
+    t_end: float
+    value: float
+    axis: tuple[float, float, float]
+    label: str
+
+    def to_dict(self) -> dict:
+        """The JSON form (SI values: rad/s or rad, s)."""
+        return {"name": self.name, "kind": self.kind, "start": self.start, "end": self.end, "t_start": self.t_start,
+                "t_end": self.t_end, "value": self.value, "axis": list(self.axis), "label": self.label}
 
 
 @dataclass(frozen=True)

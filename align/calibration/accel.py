@@ -25,7 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from align.alignment.estimate import Observation, fit_lsq
+from align.alignment.estimate import fit_lsq
+from align.alignment.observe import Observation
 from align.alignment.segment import Segment, static_intervals
 from align.calibration.positions import parse_positions, positions_of
 from align.calibration.results import Calibration

@@ -5,8 +5,9 @@ import pytest
 from conftest import truth_model
 from scipy.spatial.transform import Rotation
 
-from align.alignment.estimate import Observation, fit_rate_pairs
+from align.alignment.estimate import fit_rate_pairs
 from align.alignment.job import AlignOptions, align
+from align.alignment.observe import Observation
 from align.alignment.plan import Plan, Step
 from align.alignment.segment import Segment
 from align.alignment.simulate import SessionSpec, simulate_session

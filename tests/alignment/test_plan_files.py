@@ -24,13 +24,15 @@ def _plan(tmp_path, text):
 
 @pytest.mark.parametrize("text,words", [
     ('[test]\nlatitud = "48.1 deg"\n' + STEP,
-     "plan.toml: [test]: unknown key 'latitud' (did you mean 'latitude'? known: latitude, rate_accuracy, angle_accuracy)"),
+     "plan.toml: [test]: unknown key 'latitud' (did you mean 'latitude'? known: latitude, rate_accuracy, angle_accuracy, "
+     "table_axis, rest)"),
     ('[test]\nrate_acuracy = "0.01 %"\n' + STEP, "[test]: unknown key 'rate_acuracy' (did you mean 'rate_accuracy'?"),
     ('[[step]]\naxis = "+x"\nrat = "100 deg/s"\n', "plan.toml: step 1: unknown key 'rat' (did you mean 'rate'?"),
     (STEP + '[[step]]\naxis = "+y"\nangle = "90 deg"\nangel = "9 deg"\n', "step 2: unknown key 'angel' (did you mean 'angle'?"),
-    ('[[steps]]\naxis = "+x"\nrate = "100 deg/s"\n', "plan.toml: unknown key 'steps' (did you mean 'step'? known: test, step)"),
+    ('[[steps]]\naxis = "+x"\nrate = "100 deg/s"\n',
+     "plan.toml: unknown key 'steps' (did you mean 'step'? known: test, step, mounting)"),
     ('[tests]\nlatitude = "48 deg"\n' + STEP, "plan.toml: unknown key 'tests' (did you mean 'test'?"),
-    ('latitude = "48 deg"\n' + STEP, "plan.toml: unknown key 'latitude' (known: test, step)"),
+    ('latitude = "48 deg"\n' + STEP, "plan.toml: unknown key 'latitude' (known: test, step, mounting)"),
     ('[step]\naxis = "+x"\nrate = "100 deg/s"\n', "plan.toml: [step] must be an array of tables: write [[step]]"),
     ('[test]\nlatitude = "48 deg"\n', "plan.toml: no [[step]] tables"),
     ('test = 3\n' + STEP, "plan.toml: [test] must be a table"),
