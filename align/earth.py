@@ -2,7 +2,7 @@
 
 Public names
 ------------
-EARTH_RATE, vertical_rate, earth_rate_in_frame
+EARTH_RATE, vertical_rate, earth_rate_enu, earth_rate_in_frame
 """
 
 from __future__ import annotations
@@ -27,6 +27,22 @@ def vertical_rate(latitude: float) -> float:
         rad/s; 7.29e-5 rad/s (15.041 deg/h) at the pole.
     """
     return EARTH_RATE * np.sin(latitude)
+
+
+def earth_rate_enu(latitude: float) -> np.ndarray:
+    """Earth rate in the local level frame (east, north, up): ``Omega (0, cos L, sin L)``.
+
+    Parameters
+    ----------
+    latitude : float
+        Geodetic latitude ``L``, rad.
+
+    Returns
+    -------
+    ndarray, shape (3,)
+        rad/s.
+    """
+    return EARTH_RATE * np.array([0.0, np.cos(latitude), np.sin(latitude)])
 
 
 def earth_rate_in_frame(latitude: float, up: np.ndarray, heading: np.ndarray) -> np.ndarray:

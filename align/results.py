@@ -40,7 +40,7 @@ from align.values import Value
 
 #: every result format -> the module that defines (and registers) its type
 KNOWN: dict[str, str] = {
-    "imu-align.alignment": "align.alignment.job",
+    "imu-align.alignment": "align.alignment.result",
     "imu-align.truth": "align.alignment.simulate",
     "imu-align.calibration": "align.calibration.results",
     "imu-align.magnetometer": "align.calibration.magnetometer",

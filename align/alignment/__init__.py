@@ -15,8 +15,9 @@ Equations are those of M. Looney, "The Basics of MEMS IMU/Gyroscope Alignment",
 Analog Dialogue (reference ``alignment-basics.md``).
 """
 
-from align.alignment.job import AlignmentResult, AlignOptions, align
+from align.alignment.job import AlignOptions, align
 from align.alignment.plan import Plan, Step
+from align.alignment.result import AlignmentResult
 from align.alignment.segment import Segment, SegmentOptions
 from align.alignment.simulate import SessionSpec, simulate_session
 

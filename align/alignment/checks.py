@@ -2,8 +2,8 @@
 
 Each check either passes (returning a :class:`Check` to show in the result) or
 raises :class:`~align.errors.TestError` naming the segment or step and what to
-do. They assume the gyro axes are nominally aligned with the system axes (the
-misalignment being measured is a few degrees, not a re-mounted IMU).
+do. Directions are judged relative to the nominal mounting (the misalignment
+being measured is a few degrees from it).
 
 Public names
 ------------
@@ -248,7 +248,8 @@ def check_directions(measured: list[tuple[Segment, float, float]], plan: Plan, t
     return Check("directions", "pass", f"every step within {100 * tolerance:g} % of the plan, in the planned direction")
 
 
-def check_scale(m: np.ndarray, tolerance: float, where: str = "result") -> Check:
+def check_scale(m: np.ndarray, tolerance: float, where: str = "result", assumed: int | None = None,
+                scale_spec: float | None = None) -> list[Check]:
     """Scale factors ``|M[i, :]|`` (reference section 1) must lie within ``1 +/- tolerance``.
 
     Parameters
@@ -259,27 +260,38 @@ def check_scale(m: np.ndarray, tolerance: float, where: str = "result") -> Check
         Largest allowed ``| |M[i, :]| - 1 |``, dimensionless (e.g. 0.2).
     where : str
         Names the result in the error message.
+    assumed : int, optional
+        A gyro whose scale was assumed, not measured (the two-axis shortcut, Eq 35-36): not checked.
+    scale_spec : float, optional
+        The stated scale spec the assumption rests on (relative), for the not-checked entry.
 
     Returns
     -------
-    Check
-        ``"pass"``, listing the three scale factors.
+    list of Check
+        ``"pass"`` listing the measured scale factors, and ``"not checked"`` for an assumed one.
 
     Raises
     ------
     TestError
-        For the first gyro whose scale factor is outside the band (or NaN).
+        For the first measured gyro whose scale factor is outside the band (or NaN).
     """
     scale = np.linalg.norm(m, axis=1)
-    bad = scale_outside(m, tolerance)
+    measured = [i for i in range(3) if i != assumed]
+    bad = scale_outside(m[measured], tolerance)
     if bad is not None:
-        i, s = bad
+        i, s = measured[bad[0]], bad[1]
         raise TestError(
             f"gyro {'xyz'[i]} scale factor {s:.4f} is outside 1 +/- {tolerance:g}: wrong gyro units, "
             "wrong table rate, or a broken gyro (raise {scale_tolerance} if this is expected)",
             where,
         )
-    return Check("scale", "pass", f"scale factors {', '.join(f'{s:.5f}' for s in scale)} within 1 +/- {tolerance:g}")
+    shown = ", ".join(f"{'xyz'[i]} {scale[i]:.5f}" for i in measured)
+    out = [Check("scale", "pass", f"scale factors {shown} within 1 +/- {tolerance:g}")]
+    if assumed is not None:
+        spec = "" if scale_spec is None else f" +/- {100 * scale_spec:g} % (the stated scale spec, in its uncertainty)"
+        out.append(Check(f"scale {'xyz'[assumed]}", NOT_CHECKED,
+                         f"gyro {'xyz'[assumed]} scale not observable (its axis never turned): assumed 1{spec}"))
+    return out
 
 
 def check_residuals(segments: list[Segment], rms: np.ndarray, expected: np.ndarray, units: str) -> Check:

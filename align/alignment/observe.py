@@ -5,9 +5,24 @@
   ``phi = [theta_k u_k; T_k]`` (``T_k`` the duration, so a bias adds ``b T_k``);
 * static period: ``y`` = mean reading, ``phi = [w_earth; 1]`` (``[0; 1]`` without an Earth-rate correction).
 
+Earth rate (reference section 4, last item), with a latitude: ``Omega_L = Omega (0, cos L, sin L)`` in the
+local level frame (:func:`align.earth.earth_rate_enu`). What the plan's geometry
+(:mod:`align.alignment.geometry`) allows is modelled in ``phi``, and what it does not goes into ``var``:
+
+* a dwell or turn about the table axis ``a``: the component ``Omega_L . a`` along the spin axis is modelled;
+  the part across it (size ``P = |Omega_L x a|``) turns with the table, and its mean over the segment has the
+  size ``P |sum_k exp(i theta_k) dt_k| / T`` (``theta`` the table angle, from the readings; only its direction,
+  set by the unknown heading, is unknown), which enters the variance as ``size^2 / 2`` on each of the two
+  directions across the axis;
+* a static period just before a step with a stated ``rest``: the whole vector ``C^T Omega_L``;
+* a static period with the step's axis along the table axis but no rest: the component along it; the part
+  across (``P``, direction unknown) enters the variance;
+* a static period after a motion the plan does not list: nothing modelled; ``Omega^2 / 3`` per axis enters
+  the variance.
+
 Public names
 ------------
-Observation, observe
+Observation, EarthModel, observe
 """
 
 from __future__ import annotations
@@ -16,9 +31,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from align.alignment.plan import Plan
+from align.alignment.plan import Plan, Step
 from align.alignment.segment import Segment, integrate
-from align.earth import vertical_rate
+from align.earth import EARTH_RATE, earth_rate_enu
 from align.values import Value
 
 
@@ -61,8 +76,71 @@ def _batch_mean_var(x: np.ndarray, batches: int = 10) -> np.ndarray:
     return np.var(means, axis=0, ddof=1) / batches
 
 
+@dataclass(frozen=True)
+class EarthModel:
+    """What of the Earth rate the observations model (see the module docstring).
+
+    Attributes
+    ----------
+    latitude : float or None
+        rad; None: not modelled at all.
+    steps : int
+        Dwells and turns with the component along the spin axis modelled.
+    whole : int
+        Static periods with the whole vector modelled (rest orientation stated).
+    along : int
+        Static periods with the component along the table axis modelled.
+    unknown : int
+        Static periods after a motion the plan does not list (nothing modelled).
+    across : float
+        Largest unmodelled part put into an observation's variance, rad/s (turns: per second of turn).
+    along_rate : tuple of float
+        The distinct along-axis components modelled, rad/s.
+    """
+
+    latitude: float | None
+    steps: int = 0
+    whole: int = 0
+    along: int = 0
+    unknown: int = 0
+    across: float = 0.0
+    along_rate: tuple[float, ...] = ()
+
+
+def _across_var(size: float, u: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """Per-gyro variance of a vector of ``size`` with an unknown direction across the system axis ``u``."""
+    return size**2 / 2 * np.maximum(1.0 - (n @ u) ** 2, 0.0)
+
+
+def _turning_mean(t: np.ndarray, g: np.ndarray, seg: Segment, direction: np.ndarray) -> float:
+    """``|sum_k exp(i theta_k) dt_k|`` over the segment, ``theta`` integrated from the readings along ``direction``."""
+    stop = min(seg.end + 1, len(t))
+    dt = np.diff(t[seg.start : stop])
+    dt = np.append(dt, dt[-1:]) if len(dt) < seg.n else dt
+    theta = np.cumsum(g[seg.start : seg.end] @ direction * dt)
+    return float(abs(np.sum(np.exp(1j * theta) * dt)))
+
+
+def _static_geometry(seg: Segment, steps: list[Segment], moves: list[tuple[int, int]], plan: Plan
+                     ) -> tuple[str, Step | None]:
+    """How a static period sits: ``("whole" | "along" | "unknown", the step whose axis is along the table)``."""
+    after = [s for s in steps if s.start >= seg.end]
+    before = [s for s in steps if s.end <= seg.start]
+
+    def clear(a: int, b: int) -> bool:
+        return not any(a < e and s < b for s, e in moves)
+
+    if after and clear(seg.end, after[0].start):
+        step = plan.steps[after[0].step]
+        return ("whole" if step.rest is not None else "along"), step
+    if before and clear(before[-1].end, seg.start):
+        return "along", plan.steps[before[-1].step]
+    return "unknown", None
+
+
 def observe(t: np.ndarray, g: np.ndarray, segments: list[Segment], plan: Plan, sigma: np.ndarray,
-            earth: bool = False) -> list[Observation]:
+            earth: bool = False, mounting: np.ndarray | None = None,
+            moves: list[tuple[int, int]] = ()) -> tuple[list[Observation], EarthModel]:
     """Turn segments into linear observations (see module docstring).
 
     Parameters
@@ -74,31 +152,70 @@ def observe(t: np.ndarray, g: np.ndarray, segments: list[Segment], plan: Plan, s
     sigma : ndarray, shape (3,)
         Per-sample white-noise sigma, rad/s (for the variance of turns).
     earth : bool
-        Add the vertical Earth rate along the table axis (needs ``plan.latitude``): modelled in ``w``, not left in ``b``.
+        Model the Earth rate (needs ``plan.latitude``) as far as the plan's geometry allows.
+    mounting : ndarray, shape (3, 3), optional
+        The nominal mounting ``N`` (identity when None): which gyros an unmodelled part reaches.
+    moves : list of (int, int)
+        Sample ranges of the motions the plan does not list (after one, a rest orientation is unknown).
 
     Returns
     -------
-    list of Observation
+    observations : list of Observation
         One per segment, in order.
+    earth : EarthModel
+        What was modelled.
     """
+    n_nom = np.eye(3) if mounting is None else np.asarray(mounting, float)
     dt = float(np.median(np.diff(t)))
-    e_up = vertical_rate(plan.latitude) if earth and plan.latitude is not None else 0.0
-    out = []
+    lat = plan.latitude if earth else None
+    omega = earth_rate_enu(lat) if lat is not None else np.zeros(3)
+    steps = [s for s in segments if s.step is not None]
+    out, model = [], {"steps": 0, "whole": 0, "along": 0, "unknown": 0, "across": 0.0}
+    along_rates = set()
     for seg in segments:
         x = g[seg.start : seg.end]
+        extra = np.zeros(3)
         if seg.kind == "angle":
             step = plan.steps[seg.step]
             y, duration = integrate(t, g, seg.start, seg.end)
-            phi = np.append((step.angle + e_up * duration) * step.unit_axis, duration)
+            along = float(omega @ step.table_vector)
+            phi = np.append((step.angle + along * duration) * step.unit_axis, duration)
             var = sigma**2 * dt * duration
         else:
             duration = seg.n * dt
             y = x.mean(axis=0)
+            var = np.maximum(_batch_mean_var(x), sigma**2 / seg.n)
             if seg.kind == "rate":
                 step = plan.steps[seg.step]
-                phi = np.append((step.rate + e_up) * step.unit_axis, 1.0)
+                along = float(omega @ step.table_vector)
+                phi = np.append((step.rate + along) * step.unit_axis, 1.0)
             else:
-                phi = np.array([0.0, 0.0, 0.0, 1.0])
-            var = np.maximum(_batch_mean_var(x), sigma**2 / seg.n)
-        out.append(Observation(seg, y, phi, np.maximum(var, _VAR_FLOOR), duration))
-    return out
+                phi, extra = _static_phi(seg, steps, list(moves), plan, omega, n_nom, model, along_rates)
+        if seg.kind != "static" and lat is not None:
+            across = float(np.linalg.norm(np.cross(omega, step.table_vector)))
+            size = across * _turning_mean(t, g, seg, n_nom @ step.unit_axis) / (1.0 if seg.kind == "angle" else duration)
+            extra = _across_var(size, step.unit_axis, n_nom)
+            model["steps"] += 1
+            model["across"] = max(model["across"], size / (duration if seg.kind == "angle" else 1.0))
+            along_rates.add(round(along, 15))
+        out.append(Observation(seg, y, phi, np.maximum(var + extra, _VAR_FLOOR), duration))
+    return out, EarthModel(lat, along_rate=tuple(sorted(along_rates)), **model)
+
+
+def _static_phi(seg: Segment, steps: list[Segment], moves: list[tuple[int, int]], plan: Plan, omega: np.ndarray,
+                n_nom: np.ndarray, model: dict, along_rates: set) -> tuple[np.ndarray, np.ndarray]:
+    """``phi`` of a static period and the variance of the Earth rate it leaves unmodelled (zeros without Earth)."""
+    if not omega.any():
+        return np.array([0.0, 0.0, 0.0, 1.0]), np.zeros(3)
+    how, step = _static_geometry(seg, steps, moves, plan)
+    model[how] += 1
+    if how == "whole":
+        return np.append(step.rest_matrix.T @ omega, 1.0), np.zeros(3)
+    if how == "unknown":
+        model["across"] = max(model["across"], EARTH_RATE)
+        return np.array([0.0, 0.0, 0.0, 1.0]), np.full(3, EARTH_RATE**2 / 3)
+    along = float(omega @ step.table_vector)
+    across = float(np.linalg.norm(np.cross(omega, step.table_vector)))
+    model["across"] = max(model["across"], across)
+    along_rates.add(round(along, 15))
+    return np.append(along * step.unit_axis, 1.0), _across_var(across, step.unit_axis, n_nom)

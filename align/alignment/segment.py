@@ -9,8 +9,8 @@ plateaus. Everything here works on SI arrays and never reads files.
 
 Public names
 ------------
-Segment, Motion, SegmentOptions, noise_sigma, find_plateaus, integrate, segment_log, segments_from_ranges,
-static_intervals
+Segment, Motion, Segmentation, SegmentOptions, noise_sigma, find_plateaus, integrate, segment_log,
+segments_from_ranges, true_runs
 """
 
 from __future__ import annotations
@@ -19,10 +19,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from align.alignment.match import Candidate, match_steps
 from align.alignment.plan import Plan
 from align.errors import InputError, TestError, literal
 from align.io.keys import check_keys, require_keys
-from align.units import DEG_S, unit_mixup_hint
+from align.units import DEG, DEG_S, unit_mixup_hint
 
 
 @dataclass(frozen=True)
@@ -126,7 +127,7 @@ def _moving_mean(g: np.ndarray, w: int) -> np.ndarray:
     return out / w
 
 
-def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+def true_runs(mask: np.ndarray) -> list[tuple[int, int]]:
     """Start/end (exclusive) of the runs of True in a boolean array."""
     edges = np.diff(np.concatenate(([0], mask.view(np.int8), [0])))
     starts = np.flatnonzero(edges == 1)
@@ -157,7 +158,7 @@ def find_plateaus(g: np.ndarray, fs: float, opts: SegmentOptions, sigma: np.ndar
     margin = int(round(opts.margin_s * fs))
     shortest = max(int(round(opts.min_plateau_s * fs)), 2)
     out = []
-    for s, e in _runs(steady_mid):
+    for s, e in true_runs(steady_mid):
         a, b = s + w + margin, e + w - margin
         if b - a >= shortest:
             out.append((a, b))
@@ -177,22 +178,101 @@ def integrate(t: np.ndarray, g: np.ndarray, start: int, end: int) -> tuple[np.nd
     return dt @ g[start:end], float(dt.sum())
 
 
-def _describe(g: np.ndarray, t: np.ndarray, runs: list[tuple[int, int]]) -> str:
-    parts = []
-    for s, e in runs[:12]:
-        mean = np.mean(g[s:e], axis=0) / DEG_S
-        parts.append(f"t={t[s]:.2f}-{t[e - 1]:.2f} s ({mean[0]:+.2f}, {mean[1]:+.2f}, {mean[2]:+.2f} deg/s)")
-    more = f" and {len(runs) - 12} more" if len(runs) > 12 else ""
-    return "; ".join(parts) + more
+def _split_static(g: np.ndarray, runs: list[tuple[int, int]], plan: Plan,
+                  opts: SegmentOptions) -> tuple[list[tuple[int, int]], list[tuple[int, int]]]:
+    """The plateaus that are static and the ones that move.
 
-
-def _classify(g: np.ndarray, runs: list[tuple[int, int]], threshold: float) -> tuple[list[bool], np.ndarray]:
-    means = np.array([np.mean(g[s:e], axis=0) for s, e in runs]).reshape(-1, 3)
-    if not len(runs):
-        return [], np.zeros(3)
+    A plateau is static when its mean lies within ``static_threshold`` (and, for rate plans, a quarter of the
+    slowest planned rate) of the quietest plateau; for a rate plan the quietest plateau itself must be slower than
+    half the slowest planned rate (a log without rests is all dwells).
+    """
+    if not runs:
+        return [], []
+    means = np.array([np.mean(g[a:b], axis=0) for a, b in runs])
     ref = means[int(np.argmin(np.linalg.norm(means, axis=1)))]
-    is_static = [bool(np.linalg.norm(m - ref) < threshold) for m in means]
-    return is_static, ref
+    threshold = opts.static_threshold
+    if plan.kind == "rate":
+        slowest = min(abs(s.rate) for s in plan.steps)
+        threshold = min(threshold, 0.25 * slowest)
+        if np.linalg.norm(ref) >= 0.5 * slowest:
+            return [], list(runs)
+    static = np.linalg.norm(means - ref, axis=1) < threshold
+    return [r for r, st in zip(runs, static) if st], [r for r, st in zip(runs, static) if not st]
+
+
+def _static_bias(g: np.ndarray, statics: list[tuple[int, int]]) -> np.ndarray:
+    """Mean reading over the static periods (zeros without any): the bias the candidates are judged with."""
+    if not statics:
+        return np.zeros(g.shape[1])
+    return np.sum([g[a:b].sum(axis=0) for a, b in statics], axis=0) / sum(b - a for a, b in statics)
+
+
+def _turns(t: np.ndarray, g: np.ndarray, statics: list[tuple[int, int]], sigma: np.ndarray,
+           head: bool) -> list[Candidate]:
+    """The motions between consecutive static periods (and, with ``head``, before the first), bias removed.
+
+    A stretch is a turn when its integrated reading, less the neighbouring rests' bias, exceeds
+    ``max(1 deg, 10 sigma sqrt(dt T))`` (a static period split in two is not a turn).
+    """
+    dt = float(np.median(np.diff(t)))
+    pieces = [(None, statics[0])] if head and statics and statics[0][0] > 0 else []
+    pieces += list(zip(statics[:-1], statics[1:]))
+    out = []
+    for before, after in pieces:
+        e0, s1 = (0 if before is None else before[1]), after[0]
+        if s1 <= e0:
+            continue
+        rests = [r for r in (before, after) if r is not None]
+        bias = np.mean([np.mean(g[a:b], axis=0) for a, b in rests], axis=0)
+        angle, duration = integrate(t, g, e0, s1)
+        v = angle - bias * duration
+        if np.linalg.norm(v) > max(DEG, 10 * float(np.linalg.norm(sigma)) * np.sqrt(dt * duration)):
+            out.append(Candidate("turn", e0, s1, v))
+    return out
+
+
+def _describer(t: np.ndarray):
+    def describe(c: Candidate) -> str:
+        v = c.vector / (DEG_S if c.kind == "rate" else DEG)
+        unit = "deg/s" if c.kind == "rate" else "deg"
+        return f"t={t[c.start]:.2f}-{t[c.end - 1]:.2f} s: ({v[0]:+.2f}, {v[1]:+.2f}, {v[2]:+.2f}) {unit}"
+    return describe
+
+
+def _merge_similar(g: np.ndarray, runs: list[tuple[int, int]], tol: float, max_gap: int) -> list[tuple[int, int]]:
+    """Join consecutive plateaus split by a short glitch: their means, and the samples between, agree within ``tol``."""
+    out: list[tuple[int, int]] = []
+    for s, e in runs:
+        if out and s - out[-1][1] <= max_gap:
+            ps, pe = out[-1]
+            mean = np.mean(g[ps:pe], axis=0)
+            if np.linalg.norm(mean - np.mean(g[s:e], axis=0)) < tol and np.linalg.norm(mean - np.mean(g[pe:s], axis=0)) < tol:
+                out[-1] = (ps, e)
+                continue
+        out.append((s, e))
+    return out
+
+
+@dataclass(frozen=True)
+class Segmentation:
+    """What :func:`segment_log` found.
+
+    Attributes
+    ----------
+    segments : tuple of Segment
+        One per plan step, in plan order (``step`` its index), then the static periods.
+    unclaimed : tuple of Candidate
+        Motions no step took (plateaus and turns between rests), in time order; vectors in the gyro frame.
+    mounting : ndarray, shape (3, 3)
+        The nominal mounting ``N`` the steps were found with (:mod:`align.alignment.geometry`).
+    source : str
+        ``"declared"`` (the plan's ``[mounting]``) or ``"detected"``.
+    """
+
+    segments: tuple[Segment, ...]
+    unclaimed: tuple[Candidate, ...]
+    mounting: np.ndarray
+    source: str
 
 
 def segment_log(
@@ -202,8 +282,8 @@ def segment_log(
     opts: SegmentOptions = SegmentOptions(),
     where: str = "log",
     sigma: np.ndarray | None = None,
-) -> list[Segment]:
-    """Find the plan's steps (and the static periods) in a log.
+) -> Segmentation:
+    """Find the plan's steps (in order, among whatever else the log holds) and the static periods.
 
     Parameters
     ----------
@@ -221,73 +301,48 @@ def segment_log(
 
     Returns
     -------
-    list of Segment
-        One per plan step (``kind`` = the step's kind, ``step`` its index), in
-        order, plus the static periods (``kind="static"``).
+    Segmentation
+        Rate steps are constant-rate plateaus; angle steps the motion between two rests (a log that starts
+        moving gives a turn from its first sample). Motions the plan does not list are kept as unclaimed.
 
     Raises
     ------
     TestError
-        When the number of dwells or turns found differs from the plan; the
-        message lists what was found and where.
+        When a planned step cannot be found (named, with what the log shows instead), a unit mix-up, or an
+        IMU mounted at an angle that the plan does not declare (:func:`align.alignment.match.match_steps`).
+    HandednessError
+        When the steps fit only a mirrored mounting.
     """
     if plan.kind == "mixed":
         raise InputError("the plan mixes rate and angle steps; automatic segmentation needs one kind (or give {segments})", where)
     fs = 1.0 / float(np.median(np.diff(t)))
-    runs = find_plateaus(g, fs, opts, noise_sigma(g) if sigma is None else sigma)
+    sigma = noise_sigma(g) if sigma is None else sigma
+    runs = find_plateaus(g, fs, opts, sigma)
+    statics, moving = _split_static(g, runs, plan, opts)
+    bias = _static_bias(g, statics)
+    turns = _turns(t, g, statics, sigma, head=plan.kind == "angle")
     if plan.kind == "rate":
-        threshold = 0.25 * min(abs(s.rate) for s in plan.steps)
-        is_static, ref = _classify(g, runs, threshold)
-        if np.linalg.norm(ref) >= threshold:
-            is_static = [False] * len(runs)
-        moving = [r for r, st in zip(runs, is_static) if not st]
-        moving = _merge_similar(g, moving, 0.02 * threshold / 0.25, int(fs))
-        if len(moving) != len(plan.steps):
-            biggest = sorted(np.linalg.norm(np.mean(g[a:b], axis=0)) for a, b in runs)[-len(plan.steps):]
-            hint = unit_mixup_hint(float(np.median(biggest)) / float(np.median([abs(s.rate) for s in plan.steps])))
-            if runs and hint:
-                raise TestError(hint, where)
-            raise _count_error("constant-rate dwells", len(moving), plan, f"dwells found: {_describe(g, t, moving) or 'none'}",
-                               "check the plan, {window}/{min_dwell}, or give {segments}", where)
-        segs = [Segment(f"step {k + 1} ({s.label})", "rate", a, b, k) for k, (s, (a, b)) in enumerate(zip(plan.steps, moving))]
+        moving = _merge_similar(g, moving, 0.08 * min(abs(s.rate) for s in plan.steps), int(fs))
+        cands = [Candidate("rate", a, b, np.mean(g[a:b], axis=0) - bias) for a, b in moving]
     else:
-        is_static, _ = _classify(g, runs, opts.static_threshold)
-        statics = [r for r, st in zip(runs, is_static) if st]
-        min_angle = 0.2 * min(abs(s.angle) for s in plan.steps)
-        turns = []
-        for (s0, e0), (s1, e1) in zip(statics[:-1], statics[1:]):
-            bias = 0.5 * (np.mean(g[s0:e0], axis=0) + np.mean(g[s1:e1], axis=0))
-            angle, duration = integrate(t, g, e0, s1)
-            if np.linalg.norm(angle - bias * duration) > min_angle:
-                turns.append((e0, s1))
-        if len(turns) != len(plan.steps):
-            found = "; ".join(f"t={t[a]:.2f}-{t[b - 1]:.2f} s" for a, b in turns) or "none"
-            raise _count_error("turns between static periods", len(turns), plan,
-                               f"turns found: {found}; static periods: {len(statics)}",
-                               "each turn must start and end at rest (check {static_threshold}, or give {segments})", where)
-        segs = [Segment(f"step {k + 1} ({s.label})", "angle", a, b, k) for k, (s, (a, b)) in enumerate(zip(plan.steps, turns))]
-        moving = turns
-    statics = [r for r, st in zip(runs, is_static) if st]
+        cands = turns
+    try:
+        match = match_steps(plan, cands, _describer(t), where)
+    except TestError:
+        sizes = sorted(float(np.linalg.norm(c.vector)) for c in cands)[-len(plan.steps):]
+        planned = [abs(s.rate if s.rate is not None else s.angle) for s in plan.steps]
+        hint = unit_mixup_hint(float(np.median(sizes)) / float(np.median(planned))) if sizes else None
+        if hint:
+            raise TestError(hint, where) from None
+        raise
+    segs = [Segment(f"step {k + 1} ({s.label})", s.kind, a, b, k) for k, (s, (a, b)) in enumerate(zip(plan.steps, match.ranges))]
     segs += [Segment(f"static {k + 1}", "static", a, b) for k, (a, b) in enumerate(statics)]
-    return segs
-
-
-def _count_error(what: str, found: int, plan: Plan, detail: str, advice: str, where: str) -> TestError:
-    """The segmentation found another number of steps than the plan lists."""
-    return TestError(f"found {found} {what} but the plan has {len(plan.steps)} steps; {detail}; {advice}", where)
-
-
-def _merge_similar(g: np.ndarray, runs: list[tuple[int, int]], tol: float, max_gap: int) -> list[tuple[int, int]]:
-    """Join consecutive plateaus split by a short glitch when their means agree within ``tol``."""
-    out: list[tuple[int, int]] = []
-    for s, e in runs:
-        if out and s - out[-1][1] <= max_gap:
-            ps, pe = out[-1]
-            if np.linalg.norm(np.mean(g[ps:pe], axis=0) - np.mean(g[s:e], axis=0)) < tol:
-                out[-1] = (ps, e)
-                continue
-        out.append((s, e))
-    return out
+    unclaimed = list(match.unclaimed)
+    if plan.kind == "rate":  # the moves between rests that hold no dwell at all (fixture re-orientations)
+        taken = [(s.start, s.end) for s in segs if s.kind == "rate"] + [(c.start, c.end) for c in unclaimed]
+        unclaimed += [c for c in turns if not any(a < c.end and c.start < b for a, b in taken)]
+    unclaimed.sort(key=lambda c: c.start)
+    return Segmentation(tuple(segs), tuple(unclaimed), match.mounting, match.source)
 
 
 #: the keys of one range of an explicit segments file
@@ -334,36 +389,3 @@ def segments_from_ranges(ranges: dict, plan: Plan, n: int, where: str = "segment
     if k != len(plan.steps):
         raise InputError(f"{k} step segments for a plan of {len(plan.steps)} steps; give one per step, in plan order", where)
     return segs
-
-
-def static_intervals(x: np.ndarray, fs: float, window_s: float = 1.0, factor: float = 6.0,
-                     init_static_s: float | None = None, min_duration_s: float = 1.0) -> list[tuple[int, int]]:
-    """Static intervals by a moving-variance threshold (imu_tk's detector).
-
-    The variance of each axis over a trailing window of ``window_s`` is summed;
-    the threshold is ``factor`` times its median over the initial static period
-    (``init_static_s``, as imu_tk does) or, without one, over the quietest tenth
-    of the record. Runs below it lasting ``min_duration_s`` are kept, trimmed by
-    half a window at each end.
-    """
-    w = max(3, int(round(window_s * fs)))
-    if len(x) < 3 * w:
-        raise InputError(f"only {len(x)} samples: too short for a {window_s:g} s variance window")
-    c1 = np.cumsum(np.vstack([np.zeros((1, x.shape[1])), x]), axis=0)
-    c2 = np.cumsum(np.vstack([np.zeros((1, x.shape[1])), x * x]), axis=0)
-    mean = (c1[w:] - c1[:-w]) / w
-    var = np.maximum((c2[w:] - c2[:-w]) / w - mean**2, 0.0).sum(axis=1)   # var[k]: samples k..k+w-1
-    if init_static_s:
-        ref = var[: max(1, int(init_static_s * fs) - w)]
-    else:
-        ref = np.sort(var)[: max(1, len(var) // 10)]
-    thr = factor * float(np.median(ref))
-    quiet = np.zeros(len(x), dtype=bool)
-    quiet[w // 2 : w // 2 + len(var)] = var < thr
-    out = []
-    half = w // 2
-    for a, b in _runs(quiet):
-        a, b = a + half, b - half
-        if b - a >= min_duration_s * fs:
-            out.append((a, b))
-    return out

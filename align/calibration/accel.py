@@ -27,9 +27,10 @@ import numpy as np
 
 from align.alignment.estimate import fit_lsq
 from align.alignment.observe import Observation
-from align.alignment.segment import Segment, static_intervals
+from align.alignment.segment import Segment
 from align.calibration.positions import parse_positions, positions_of
 from align.calibration.results import Calibration
+from align.calibration.statics import static_intervals
 from align.errors import InputError, TestError, literal
 from align.io import check_log
 from align.plausible import check_at_rest, check_axes, check_gravity, check_scale_factors
@@ -101,7 +102,7 @@ def norms_at_rest(x: np.ndarray, ranges: dict) -> np.ndarray:
 @dataclass(frozen=True)
 class StaticDetector:
     """Settings of the static-interval detector (imu_tk's moving variance, see
-    :func:`align.alignment.segment.static_intervals`): window (s), threshold factor,
+    :func:`align.calibration.statics.static_intervals`): window (s), threshold factor,
     initial static period (s, or None) and shortest interval (s)."""
 
     window_s: float = 1.0
@@ -152,7 +153,7 @@ def accel_session(t: np.ndarray, a: np.ndarray, intervals: list, positions: list
     t, a : ndarray
         Time (s) and readings (n, 3), SI or counts.
     intervals : list of (start, end)
-        Static intervals found by :func:`align.alignment.segment.static_intervals`,
+        Static intervals found by :func:`align.calibration.statics.static_intervals`,
         used when the positions give no ``start``/``end`` (matched in order) and
         for the free fit.
     positions : list of dict or None

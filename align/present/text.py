@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from align.alignment.job import AlignmentResult
+from align.alignment.result import AlignmentResult
 from align.units import DEG, to_unit
 
 if TYPE_CHECKING:

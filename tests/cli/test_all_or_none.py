@@ -69,7 +69,7 @@ def _fails_leaving_nothing(run_cli, out: Path, before: dict, *args, code: int = 
 
 @pytest.mark.parametrize("failure,code", [(_boom, 2), (_interrupt, 130)], ids=["error", "ctrl-c"])
 def test_matrix_json_then_a_failing_c_header(tmp_path, session, run_cli, monkeypatch, failure, code):
-    from align.alignment.job import AlignmentResult
+    from align.alignment.result import AlignmentResult
 
     log, plan = session
     out = tmp_path / "out"

@@ -5,7 +5,7 @@ import re
 import numpy as np
 import pytest
 
-from align.alignment.job import AlignmentResult
+from align.alignment.result import AlignmentResult
 from align.errors import HandednessError, InputError, TestError
 from align.plausible import (
     check_at_rest,

@@ -9,7 +9,7 @@ import pytest
 from conftest import ROOT
 
 from align.alignment import Plan, align
-from align.alignment.job import AlignmentResult
+from align.alignment.result import AlignmentResult
 from align.errors import InputError
 from align.io import read_log, read_toml
 from align.results import KNOWN, load_result, result_from_dict, save_result
