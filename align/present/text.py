@@ -36,6 +36,11 @@ def matrix_text(m: np.ndarray, sigma: np.ndarray | None = None, digits: int = 6,
     return "\n".join(lines)
 
 
+def _assumed_gyro(r: AlignmentResult) -> int | None:
+    """The gyro whose scale the two-axis shortcut assumed (None when every scale was measured)."""
+    return None if r.inferred_axis is None else int(np.argmax(np.abs(r.mounting[:, r.inferred_axis])))
+
+
 def alignment_summary(r: AlignmentResult) -> str:
     """The summary ``imu-align matrix`` prints: M, A, bias, angles, segments, checks."""
     u = r.units
@@ -45,8 +50,9 @@ def alignment_summary(r: AlignmentResult) -> str:
            "A = M^-1 (1-sigma):", matrix_text(r.A, r.sigma_A), "",
            "bias [" + u + "]: " + ", ".join(f"{b:+.5g} ± {s:.2g}" for b, s in zip(to_unit(r.bias, u), to_unit(r.sigma_bias, u))),
            "",
-           "angles [deg]:",
-           "  scale factors      " + "  ".join(f"{s:.6f}" for s in ang.scale),
+           "angles [deg]" + ("" if np.allclose(r.mounting, np.eye(3)) else ", relative to the nominal mounting") + ":",
+           "  scale factors      " + "  ".join(f"{s:.6f}" + ("(assumed)" if i == _assumed_gyro(r) else "")
+                                               for i, s in enumerate(ang.scale)),
            "  psi (axis-frame)   " + "  ".join(f"{k}={v / DEG:.4f}" for k, v in zip("xyz", ang.psi)),
            "  phi (cross-axis)   " + "  ".join(f"{'xyz'[i]}{'xyz'[j]}={ang.phi[i, j] / DEG:+.4f}"
                                                  for i in range(3) for j in range(3) if i != j),

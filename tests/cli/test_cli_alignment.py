@@ -150,7 +150,8 @@ def test_segment_too_short(tmp_path, run_cli):
 def test_plan_with_more_steps_than_the_log(tmp_path, run_cli):
     plan = Plan(RATE_PLAN.steps + (Step(2, 1, rate=50 * DEG),))
     _, log, plan_path = session(tmp_path, plan=plan, run_plan=RATE_PLAN)
-    line = _fails(run_cli, tmp_path, ("matrix", log, "--plan", plan_path), 3, "step 7 (+z at 50 deg/s) not found", "no motion left")
+    line = _fails(run_cli, tmp_path, ("matrix", log, "--plan", plan_path), 3, "step 7 (+z at 50 deg/s) not found",
+                  "no motion left")
     assert "t=" in line  # says where the dwells are
 
 
