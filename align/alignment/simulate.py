@@ -1,15 +1,28 @@
 """Rate-table session simulator: known truth for rehearsals, tests and examples.
 
-The table runs a :class:`~align.plan.Plan`: a static gap, then for each step a
+The table runs a :class:`~align.plan.Plan`: a static head, then for each step a
 ramp up at a constant angular acceleration, the dwell (rate steps) or cruise
-(angle steps), a ramp down, and another static gap. The gyros read
-``g = M (w_table + w_earth) + b(t) + noise`` with ``b(t)`` a turn-on bias plus a
-random walk, white noise from a noise density, an optional table rate/angle
-error and saturation at a stated range.
+(angle steps), a ramp down, and a static gap. The gyros read::
+
+    g = M (w_table + w_move + w_earth) + b(t) + noise
+
+with ``b(t)`` a turn-on bias plus a random walk and flicker, white noise from a noise
+density, an optional table rate/angle error and saturation at a stated range.
+
+The physics is the simulator's own (:mod:`align.alignment.kinematics`, not the estimator's):
+the orientation ``C`` (system axes in ENU) at the start of each step is the step's ``rest``
+when stated, else the current one when the step's axis already points along its table axis,
+else the smallest rotation that brings it there (the first step without ``rest``: a heading
+about the table axis drawn from the seed when Earth's rate or moves depend on it, else 0).
+With ``reorient`` the change of orientation is a move in the log (static, a turn at
+``move_rate`` with ramps at ``accel``, static); without it the orientation just switches at the
+start of the gap. Earth's rate ``C(t)^T Omega_e (0, cos L, sin L)`` is added when a latitude
+is known (the plan's, or the spec's; they must agree).
 
 Public names
 ------------
-SessionSpec, simulate_session, random_model, SimulationTruth
+SessionSpec, Move, SimulatedSession, simulate_run, simulate_session, random_model, mount_model,
+mounting_from_rotation, SimulationTruth
 """
 
 from __future__ import annotations
@@ -19,13 +32,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from align import CONVENTION
+from align.alignment import kinematics as kin
 from align.alignment.plan import Plan
-from align.earth import earth_rate_in_frame
+from align.alignment.timeline import Move, build_timeline
 from align.errors import InputError
+from align.flicker import flicker_fft, flicker_gm
 from align.model import SensorModel
 from align.plausible import malformed
 from align.results import Result, file_unit
-from align.units import DEG, DEG_S, to_unit
+from align.units import DEG, DEG_S, format_quantity, to_unit
+from align.values import Value
 
 
 @dataclass(frozen=True)
@@ -39,7 +55,7 @@ class SessionSpec:
     dwell_s : float
         Constant-rate part of each rate step, s.
     static_s : float
-        Static gap before the first step, between steps and after the last, s.
+        Static gap between steps and after the last (and on each side of a move), s.
     accel : float
         Table angular acceleration on the ramps, rad/s^2.
     turn_rate : float
@@ -53,9 +69,17 @@ class SessionSpec:
     table_angle_error : float
         Relative error of the table angle for angle steps.
     latitude : float or None
-        Adds Earth rate (rad) when set.
+        rad; adds Earth rate when set (the plan's latitude is used when this is None).
     gyro_range : float or None
         Saturation, rad/s.
+    head_s : float or None
+        Static time before the first step, s (0: the log starts moving); None: ``static_s``.
+    reorient : bool
+        Put each change of orientation between steps in the log as a move.
+    move_rate : float
+        Cruise rate of the moves, rad/s.
+    flicker : float
+        Bias instability coefficient ``B`` of each gyro (flicker, Allan floor ``0.664 B``), rad/s.
     """
 
     fs: float = 200.0
@@ -69,6 +93,10 @@ class SessionSpec:
     table_angle_error: float = 0.0
     latitude: float | None = None
     gyro_range: float | None = None
+    head_s: float | None = None
+    reorient: bool = False
+    move_rate: float = 20.0 * DEG_S
+    flicker: float = 0.0
 
     def __post_init__(self) -> None:
         """Refuse values outside their domain, each named as its input (``{dwell_s}``, ``{fs}``)."""
@@ -76,70 +104,176 @@ class SessionSpec:
                  "accel": (self.accel, 0.0, True), "turn_rate": (self.turn_rate, 0.0, True),
                  "noise_density": (self.noise_density, 0.0, False), "bias_walk": (self.bias_walk, 0.0, False),
                  "table_rate_error": (self.table_rate_error, -1.0, True),
-                 "table_angle_error": (self.table_angle_error, -1.0, True)}
+                 "table_angle_error": (self.table_angle_error, -1.0, True),
+                 "move_rate": (self.move_rate, 0.0, True), "flicker": (self.flicker, 0.0, False)}
         if self.gyro_range is not None:
             rules["gyro_range"] = (self.gyro_range, 0.0, True)
+        if self.head_s is not None:
+            rules["head_s"] = (self.head_s, 0.0, False)
         for name, (x, low, strict) in rules.items():
             if not (np.isfinite(x) and (x > low if strict else x >= low)):
                 raise InputError(f"must be finite and {'>' if strict else '>='} {low:g} (got {float(x):g})", "{" + name + "}")
         if self.latitude is not None and not (np.isfinite(self.latitude) and abs(self.latitude) <= np.pi / 2):
             raise InputError(f"must lie within -90 and 90 deg (got {float(self.latitude) / DEG:g} deg)", "{latitude}")
 
+    @property
+    def head(self) -> float:
+        """Static time before the first step, s."""
+        return self.static_s if self.head_s is None else self.head_s
+
 
 #: the most samples a simulated session may hold (about 5 GB of arrays)
 MAX_SAMPLES = 200_000_000
 
 
-def _profile(step, spec: SessionSpec) -> np.ndarray:
-    """Table rate magnitude profile (signed, rad/s) for one step, without gaps."""
-    dt = 1.0 / spec.fs
-    if step.rate is not None:
-        peak = step.rate * (1.0 + spec.table_rate_error)
-        t_ramp = abs(peak) / spec.accel
-        cruise = spec.dwell_s
-    else:
-        total = abs(step.angle) * (1.0 + spec.table_angle_error)
-        peak_abs = min(spec.turn_rate, np.sqrt(total * spec.accel))
-        t_ramp = peak_abs / spec.accel
-        cruise = (total - peak_abs * t_ramp) / peak_abs
-        peak = np.sign(step.angle) * peak_abs
-    n_ramp = max(int(np.ceil(t_ramp / dt)), 1)
-    ramp = np.linspace(0.0, 1.0, n_ramp, endpoint=False) + 0.5 / n_ramp
-    n_cruise = int(np.floor(cruise / dt))
-    prof = np.concatenate([ramp, np.ones(n_cruise), ramp[::-1]]) * peak
-    if step.angle is not None:  # put the last fraction of a sample back so the angle is exact
-        want = step.angle * (1.0 + spec.table_angle_error)
-        prof *= want / (prof.sum() * dt)
-    return prof
-
-
 def _check_size(plan: Plan, spec: SessionSpec) -> None:
     """Refuse a session too long to hold in memory, before any array is made (a bound from above:
-    each step's ramps, its dwell or its turn at the slowest cruise, and the gaps)."""
-    seconds = (len(plan.steps) + 1) * spec.static_s
+    each step's ramps, its dwell or its turn at the slowest cruise, the gaps and the moves)."""
+    seconds = spec.head + len(plan.steps) * spec.static_s
     for step in plan.steps:
         if step.rate is not None:
             seconds += spec.dwell_s + 2 * abs(step.rate) * (1 + abs(spec.table_rate_error)) / spec.accel
         else:
             total = abs(step.angle) * (1 + abs(spec.table_angle_error))
             seconds += total / min(spec.turn_rate, np.sqrt(total * spec.accel)) + 2 * spec.turn_rate / spec.accel
+    if spec.reorient:  # a move of at most half a turn, and a gap after it, before each step but the first
+        move = np.pi / min(spec.move_rate, np.sqrt(np.pi * spec.accel)) + 2 * spec.move_rate / spec.accel
+        seconds += (len(plan.steps) - 1) * (move + spec.static_s)
     n = seconds * spec.fs
     if not n <= MAX_SAMPLES:
         raise InputError(f"the session would hold about {n:.3g} samples, more than {MAX_SAMPLES:.0e}: shorten "
                          "{dwell_s} or {static_s}, or lower {fs}", "simulation")
 
 
-def simulate_session(plan: Plan, model: SensorModel, spec: SessionSpec = SessionSpec(), seed: int | np.random.Generator = 0):
-    """Simulate the gyro log of a rate-table session.
+@dataclass(frozen=True, eq=False)
+class SimulatedSession(Value):
+    """A simulated session with its truth.
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,)
+        Time, s, from 0 at ``fs``.
+    g : ndarray, shape (n, 3)
+        Gyro readings, rad/s.
+    w : ndarray, shape (n, 3)
+        True angular rate of the system frame, rad/s (table, moves and Earth).
+    bias : ndarray, shape (n, 3)
+        True bias path (turn-on, random walk, flicker), rad/s.
+    rate : ndarray, shape (n,)
+        Signed rate of the table or move about its axis, rad/s (0 when static).
+    pieces : tuple of :class:`~align.alignment.kinematics.Piece`
+        Static stretches, steps and moves in order, with the orientation at each one's start.
+    moves : tuple of Move
+        The re-orientation moves (empty without ``reorient``).
+    latitude : float or None
+        rad, the one simulated.
+    heading : float
+        Heading of the first step about its table axis, rad (when it had no stated rest).
+    fs : float
+        Hz.
+    """
+
+    t: np.ndarray
+    g: np.ndarray
+    w: np.ndarray
+    bias: np.ndarray
+    rate: np.ndarray
+    pieces: tuple
+    moves: tuple[Move, ...]
+    latitude: float | None
+    heading: float
+    fs: float
+
+    @property
+    def steps(self) -> tuple[tuple[int, int], ...]:
+        """(start, end) samples of each plan step, in plan order (end exclusive)."""
+        return tuple((p.start, p.end) for p in self.pieces if p.kind == "step")
+
+    @property
+    def rests(self) -> tuple[np.ndarray, ...]:
+        """Orientation ``C`` (3, 3) at the start of each plan step (system axes in ENU, columns)."""
+        return tuple(p.c for p in self.pieces if p.kind == "step")
+
+    def orientation(self, samples=None) -> np.ndarray:
+        """Orientation ``C`` (k, 3, 3) at ``samples`` (all when None), K1 of :mod:`align.alignment.kinematics`."""
+        idx = np.arange(len(self.t)) if samples is None else np.atleast_1d(samples)
+        return kin.orientations(self.pieces, self.rate, 1.0 / self.fs, idx)
+
+
+def _latitude(plan: Plan, spec: SessionSpec) -> float | None:
+    """The latitude simulated: the spec's or the plan's; both given, they must agree."""
+    if spec.latitude is not None and plan.latitude is not None and abs(spec.latitude - plan.latitude) > 1e-9:
+        raise InputError(f"the plan states latitude {format_quantity(plan.latitude, 'deg', 6)} but "
+                         f"{{latitude={format_quantity(spec.latitude, 'deg', 6)}}}: give one, or the same", "simulation")
+    return spec.latitude if spec.latitude is not None else plan.latitude
+
+
+def _simulate(plan: Plan, model: SensorModel, spec: SessionSpec, seed) -> dict:
+    """The session's arrays and truth, writable (see :func:`simulate_run`)."""
+    rng = np.random.default_rng(seed)
+    _check_size(plan, spec)
+    latitude = _latitude(plan, spec)
+    # the first heading matters only to Earth's rate and to moves; drawn only then (other sessions keep their noise)
+    heading = float(rng.uniform(0.0, 2 * np.pi)) if latitude is not None or spec.reorient else 0.0
+    line = build_timeline(plan, spec, heading)
+    rate = np.concatenate(line.rates)
+    pieces = tuple(line.pieces)
+    n, dt = len(rate), 1.0 / spec.fs
+    w = kin.body_rates(pieces, rate, dt, latitude)
+    bias = np.broadcast_to(model.bias, (n, 3))
+    if spec.bias_walk > 0:
+        bias = bias + np.cumsum(rng.standard_normal((n, 3)) * spec.bias_walk * np.sqrt(dt), axis=0)
+    white = rng.standard_normal((n, 3)) * spec.noise_density * np.sqrt(spec.fs)
+    if spec.flicker > 0:
+        flicker = flicker_fft if n <= FFT_FLICKER_SAMPLES else (lambda *a: flicker_gm(*a, bank=12))
+        bias = bias + flicker(n, spec.fs, spec.flicker, rng, 3)
+    g = w @ model.M.T + bias + white
+    if spec.gyro_range is not None:
+        g = np.clip(g, -spec.gyro_range, spec.gyro_range)
+    if not np.isfinite(g).all():
+        raise InputError("the simulated readings overflow (not finite): lower {noise_density} or {bias_walk}",
+                         "simulation")
+    return {"t": np.arange(n) * dt, "g": g, "w": w, "bias": bias, "rate": rate, "pieces": pieces,
+            "moves": tuple(line.moves), "latitude": latitude, "heading": heading, "fs": float(spec.fs)}
+
+
+#: longer sessions get their flicker from a bank of Gauss-Markov processes instead of one FFT
+FFT_FLICKER_SAMPLES = 1 << 24
+
+
+def simulate_run(plan: Plan, model: SensorModel, spec: SessionSpec = SessionSpec(),
+                 seed: int | np.random.Generator = 0) -> SimulatedSession:
+    """Simulate a rate-table session and keep its truth.
 
     Parameters
     ----------
     plan : Plan
-        The steps to run, in order.
+        The steps to run, in order, with their table axes and rests; its latitude adds Earth's rate.
     model : SensorModel
-        True ``M`` and turn-on bias (rad/s).
+        True ``M`` (mounting included, see :func:`mount_model`) and turn-on bias (rad/s).
     spec : SessionSpec
     seed : int or numpy.random.Generator
+
+    Returns
+    -------
+    SimulatedSession
+        ``g = M (w_table + w_move + w_earth) + b(t) + noise`` (rad/s) with ``w``, ``b(t)``, the pieces and the moves.
+
+    Raises
+    ------
+    InputError
+        The spec's and the plan's latitudes disagree; a session too long to hold; readings not finite.
+    """
+    return SimulatedSession(**_simulate(plan, model, spec, seed))
+
+
+def simulate_session(plan: Plan, model: SensorModel, spec: SessionSpec = SessionSpec(), seed: int | np.random.Generator = 0):
+    """Simulate the gyro log of a rate-table session (:func:`simulate_run` without the truth).
+
+    Parameters
+    ----------
+    plan, model, spec, seed
+        As :func:`simulate_run`.
 
     Returns
     -------
@@ -148,58 +282,51 @@ def simulate_session(plan: Plan, model: SensorModel, spec: SessionSpec = Session
     g : ndarray, shape (n, 3)
         Gyro readings, rad/s.
     w : ndarray, shape (n, 3)
-        True angular rate of the system frame, rad/s (table plus Earth).
+        True angular rate of the system frame, rad/s (table, moves and Earth).
     """
-    rng = np.random.default_rng(seed)
-    _check_size(plan, spec)
-    gap = np.zeros(int(round(spec.static_s * spec.fs)))
-    pieces, axes = [], []
-    for step in plan.steps:
-        prof = _profile(step, spec)
-        for part in (gap, prof):
-            pieces.append(part)
-            axes.append(np.repeat(step.unit_axis[None, :], len(part), axis=0))
-    pieces.append(gap)
-    axes.append(np.repeat(plan.steps[-1].unit_axis[None, :], len(gap), axis=0))
-    rate = np.concatenate(pieces)
-    up = np.concatenate(axes)
-    w = rate[:, None] * up
-    n = len(rate)
-    dt = 1.0 / spec.fs
-    if spec.latitude is not None:
-        heading = np.cumsum(rate) * dt
-        start = 0
-        for piece_axes in axes:  # Earth rate in the frame mounted for each step
-            stop = start + len(piece_axes)
-            if stop > start:
-                w[start:stop] += earth_rate_in_frame(spec.latitude, piece_axes[0], heading[start:stop])
-            start = stop
-    bias = np.broadcast_to(model.bias, (n, 3))
-    if spec.bias_walk > 0:
-        bias = bias + np.cumsum(rng.standard_normal((n, 3)) * spec.bias_walk * np.sqrt(dt), axis=0)
-    g = w @ model.M.T + bias + rng.standard_normal((n, 3)) * spec.noise_density * np.sqrt(spec.fs)
-    if spec.gyro_range is not None:
-        g = np.clip(g, -spec.gyro_range, spec.gyro_range)
-    if not np.isfinite(g).all():
-        raise InputError("the simulated readings overflow (not finite): lower {noise_density} or {bias_walk}",
-                         "simulation")
-    return np.arange(n) * dt, g, w
+    run = _simulate(plan, model, spec, seed)
+    return run["t"], run["g"], run["w"]
 
 
 def random_model(rng: np.random.Generator, misalignment: float, scale_sd: float = 2e-3, delta_sd: float = 0.05 * DEG,
-                 bias_sd: float = 0.2 * DEG) -> SensorModel:
+                 bias_sd: float = 0.2 * DEG, mounting: np.ndarray | None = None) -> SensorModel:
     """A realistic random gyro model: a mounting rotation of size ``misalignment`` (rad) about a
-    random axis, scale errors, non-orthogonality and a turn-on bias.
+    random axis, scale errors, non-orthogonality and a turn-on bias, on a nominal ``mounting``.
 
-    ``M = diag(scale) N R^T`` (see :meth:`SensorModel.from_rotation`); ``scale ~ 1 + N(0, scale_sd)``,
-    ``delta ~ N(0, delta_sd)`` rad, ``bias ~ N(0, bias_sd)`` rad/s.
+    ``M = M_small N`` with ``M_small = diag(scale) D R^T`` (see :meth:`SensorModel.from_rotation`) and ``N`` the
+    nominal mounting (rows: each gyro's nominal axis in the system frame; identity when None);
+    ``scale ~ 1 + N(0, scale_sd)``, ``delta ~ N(0, delta_sd)`` rad, ``bias ~ N(0, bias_sd)`` rad/s.
     """
     from scipy.spatial.transform import Rotation
 
     rotvec = rng.normal(size=3)
     rotvec *= misalignment / np.linalg.norm(rotvec)
-    return SensorModel.from_rotation(Rotation.from_rotvec(rotvec), scale=1 + rng.normal(0, scale_sd, 3),
-                                     delta=rng.normal(0, delta_sd, 3), bias=rng.normal(0, bias_sd, 3))
+    small = SensorModel.from_rotation(Rotation.from_rotvec(rotvec), scale=1 + rng.normal(0, scale_sd, 3),
+                                      delta=rng.normal(0, delta_sd, 3), bias=rng.normal(0, bias_sd, 3))
+    return small if mounting is None else mount_model(small, mounting)
+
+
+def _rotation(n: np.ndarray, where: str) -> np.ndarray:
+    n = np.asarray(n, float)
+    if n.shape != (3, 3) or not np.isfinite(n).all() or np.abs(n @ n.T - np.eye(3)).max() > 1e-6 \
+            or np.linalg.det(n) < 0:
+        raise InputError("a nominal mounting is a rotation (3 x 3, orthonormal rows, det +1)", where)
+    return n
+
+
+def mount_model(model: SensorModel, mounting: np.ndarray) -> SensorModel:
+    """The model of an IMU mounted nominally by ``mounting`` ``N``: ``M = M_small N``, the same bias."""
+    return SensorModel(model.M @ _rotation(mounting, "{mounting}"), model.bias)
+
+
+def mounting_from_rotation(angle: float, axis) -> np.ndarray:
+    """The nominal mounting ``N`` (3, 3) of an IMU turned by ``angle`` (rad) about ``axis`` (system frame):
+    gyro ``i`` points along ``Rot(axis, angle) e_i``, so ``N = Rot(axis, angle)^T`` (rows: the gyro axes)."""
+    axis = np.asarray(axis, float)
+    norm = np.linalg.norm(axis)
+    if axis.shape != (3,) or not np.isfinite(norm) or norm == 0 or not np.isfinite(angle):
+        raise InputError("give a finite angle about a non-zero axis", "{mounting}")
+    return kin.axis_rotation(axis / norm, angle).T
 
 
 class SimulationTruth(Result, format="imu-align.truth", convention=CONVENTION):
@@ -208,30 +335,44 @@ class SimulationTruth(Result, format="imu-align.truth", convention=CONVENTION):
     Attributes
     ----------
     model : SensorModel
-        ``g = M w + b``, bias in rad/s.
+        ``g = M w + b``, bias in rad/s; ``M`` includes the nominal mounting.
     units : str
         File unit of the bias.
     seed : int or None
         The simulation's random seed.
     inputs : dict
+    mounting : ndarray, shape (3, 3), or None
+        The nominal mounting ``N`` simulated (``M N^T`` is the small part), None when not recorded.
+    moves : tuple of Move
+        The re-orientation moves in the log.
     """
 
     model: SensorModel
     units: str = "deg/s"
     seed: int | None = None
     inputs: dict = field(default_factory=dict)
+    mounting: np.ndarray | None = None
+    moves: tuple[Move, ...] = ()
 
     def to_dict(self) -> dict:
-        return {**self.envelope({"M": "1", "bias": self.units}), "M": self.model.M.tolist(),
+        units = {"M": "1", "bias": self.units, "move_angle": "deg", "move_rate": "deg/s"}
+        return {**self.envelope(units), "M": self.model.M.tolist(),
                 "A": self.model.alignment().tolist(), "bias": to_unit(self.model.bias, self.units).tolist(),
-                "seed": self.seed, "inputs": self.inputs}
+                "mounting": None if self.mounting is None else self.mounting.tolist(),
+                "moves": [m.to_dict() for m in self.moves], "seed": self.seed, "inputs": self.inputs}
 
     @classmethod
     def from_dict(cls, d: dict, where: str = "truth") -> SimulationTruth:
-        cls.check_envelope(d, where, keys=["M", "A", "bias", "seed", "inputs"])
+        cls.check_envelope(d, where, keys=["M", "A", "bias", "mounting", "moves", "seed", "inputs"])
         try:
             u, f = file_unit(d, "bias", "angular_rate", where)
+            mounting = d.get("mounting")
+            moves = d.get("moves") or []
+            if moves:
+                fa, fr = file_unit(d, "move_angle", "angle", where)[1], file_unit(d, "move_rate", "angular_rate", where)[1]
+                moves = [Move.from_dict(m, fa, fr) for m in moves]
             return cls(SensorModel(np.array(d["M"], float), np.array(d["bias"], float) * f), u, d.get("seed"),
-                       dict(d.get("inputs", {})))
+                       dict(d.get("inputs", {})), None if mounting is None else _rotation(mounting, where),
+                       tuple(moves))
         except (KeyError, TypeError, ValueError) as exc:
             raise InputError(f"malformed simulation truth ({malformed(exc)}); regenerate it", where) from None

@@ -180,8 +180,18 @@ def allan_section(job: AllanJob | None, plot_png: bytes | None, plan: PlanResult
     return Section("Noise and test planning", body)
 
 
-def alignment_section(r) -> Section:
-    """The alignment matrix with uncertainties, angles, segment residuals and checks."""
+def _motions(motions) -> str:
+    """The motions no plan step claimed (ignored by the fit), as a table; nothing when there are none."""
+    if not motions:
+        return ""
+    rows = [[m.name, m.kind, f"{m.t_start:.2f}-{m.t_end:.2f}", m.label] for m in motions]
+    return ("<p>Motions in the log that no plan step claimed (not used in the fit):</p>"
+            + table(["motion", "kind", "t [s]", "what"], rows, left=4))
+
+
+def alignment_section(r, segmentation_png: bytes | None = None) -> Section:
+    """The alignment matrix with uncertainties, angles, segment residuals, checks and the segmentation picture
+    (:func:`align.present.plots.segmentation_plot_png`) when given."""
     u = r.units
     def mat(m, s):
         return table(["", "x", "y", "z"], [[a] + [f"{m[i, j]:+.6f} ± {s[i, j]:.1e}" for j in range(3)]
@@ -204,8 +214,11 @@ def alignment_section(r) -> Section:
                 ["scale factor"] + [f"{v:.6f}" for v in ang.scale],
                 ["psi (axis to frame)"] + [f"{v / DEG:.4f}" for v in ang.psi],
                 ["delta (xy, xz, yz)"] + [f"{v / DEG:+.4f}" for v in ang.delta]])
+            + (image(segmentation_png, "gyro traces with the plan steps, static periods, ignored motions and ramps "
+                     "found in the log") if segmentation_png else "")
             + "<p>Segments (residual per gyro):</p>"
             + table(["segment", "kind", "t [s]", "x", "y", "z", "unit"], seg_rows, left=2)
+            + _motions(getattr(r, "motions", ()))
             + table(["check", "status", "detail"], check_rows, left=3)
             + "".join(f'<p class="note">{esc(n)}</p>' for n in r.notes))
     return Section("Electronic alignment", body)

@@ -133,18 +133,20 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
     if log is not None and plan is not None:
         from align.alignment.job import align
         from align.alignment.plan import Plan
+        from align.present.plots import segmentation_plot_png
 
         the_plan = Plan.from_dict(read_toml(src(plan)), str(plan))
         t, g = read_log(src(log), ["gyro_x", "gyro_y", "gyro_z"], gyro_units)
         r = align(t, g, the_plan, units=gyro_units, where=str(log))
-        sections.append(report.alignment_section(r))
+        sections.append(report.alignment_section(r, segmentation_plot_png(t, g, r, r.units)))
         inputs["rate-table log"] = (str(log), "")
         inputs["plan"] = (str(plan), _text(src(plan)))
         results["alignment"] = r
         ang = r.angles
         lines.append(f"alignment: psi = {', '.join(f'{v / DEG:.3f}' for v in ang.psi)} deg, "
                      f"sigma(M) <= {np.nanmax(r.sigma_M):.1e}, "
-                     f"checks: {_check_counts(r.checks)}")
+                     f"checks: {_check_counts(r.checks)}"
+                     + (f"; {len(r.motions)} motion(s) no step claimed, ignored" if r.motions else ""))
     sections.insert(0, report.inputs_section(inputs))
     return report.html_report(title, sections), "\n".join(lines), results
 

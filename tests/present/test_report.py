@@ -45,7 +45,7 @@ def test_report_is_self_contained_and_every_picture_decodes(demo_dir):
     assert "g = M w + b" in page and "<script" not in page
     assert not re.search(r'(src|href)="(?!data:)', page)  # nothing loaded from outside
     images = re.findall(r'src="data:image/png;base64,([^"]+)"', page)
-    assert len(images) == 3  # histogram, assembly, Allan plot
+    assert len(images) == 4  # histogram, assembly, Allan plot, segmentation of the rate-table log
     for data in images:
         img = Image.open(io.BytesIO(base64.b64decode(data)))
         img.load()
@@ -65,7 +65,7 @@ def test_report_in_headless_chromium(demo_dir, tmp_path):
              f"--user-data-dir={tmp_path / 'profile'}", "--enable-logging=stderr", "--v=0"]
     res = subprocess.run(["chromium", *flags, "--virtual-time-budget=5000", "--dump-dom", checked.as_uri()],
                          capture_output=True, text=True, timeout=120)
-    assert "<title>images 3 broken 0</title>" in res.stdout
+    assert "<title>images 4 broken 0</title>" in res.stdout
     assert "CONSOLE" not in res.stderr and "Uncaught" not in res.stderr
     shot = tmp_path / "shot.png"
     page_uri = (demo_dir[0] / "report.html").as_uri()
