@@ -2,14 +2,20 @@
 
 Modules
 -------
-plan      the test plan (steps about system axes, rates or angles) and its TOML form
-segment   automatic segmentation of a log into dwells, turns and static periods
+geometry  frames: the local level frame, table axis, rest orientations, the nominal mounting
+plan      the test plan (mounting, table geometry, steps about system axes) and its TOML form
+segment   plateaus, static periods and the motions of a log
+match     the plan's steps found in order among the motions, with the nominal mounting
+observe   segments as linear observations, with the Earth rate the geometry allows
 estimate  estimators of ``[M | b]``: Eq 28-30 (rate pairs), Eq 31 (angle pairs), weighted
           least squares
+drift     the bias change between segments, in the observations' variances
 twoaxis   the two-axis shortcut (Eq 35-36): the third column inferred, with its cost
 checks    checks that turn a bad test into a clear error
-simulate  rate-table session simulator of known truth
-job       the alignment job (:func:`align`) and its result (:class:`AlignmentResult`)
+kinematics, timeline, simulate
+          rate-table session simulator of known truth (orientation, moves, Earth rate)
+job       the alignment job (:func:`align`)
+result    its result (:class:`AlignmentResult`) and file
 
 Equations are those of M. Looney, "The Basics of MEMS IMU/Gyroscope Alignment",
 Analog Dialogue (reference ``alignment-basics.md``).
@@ -19,7 +25,7 @@ from align.alignment.job import AlignOptions, align
 from align.alignment.plan import Plan, Step
 from align.alignment.result import AlignmentResult
 from align.alignment.segment import Segment, SegmentOptions
-from align.alignment.simulate import SessionSpec, simulate_session
+from align.alignment.simulate import SessionSpec, simulate_run, simulate_session
 
-__all__ = ["Plan", "Step", "Segment", "SegmentOptions", "SessionSpec", "simulate_session", "AlignmentResult",
-           "AlignOptions", "align"]
+__all__ = ["Plan", "Step", "Segment", "SegmentOptions", "SessionSpec", "simulate_run", "simulate_session",
+           "AlignmentResult", "AlignOptions", "align"]
