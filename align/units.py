@@ -8,7 +8,7 @@ so that a length given where an angle is expected is caught.
 Public names
 ------------
 parse_unit, parse_quantity, parse_scale, to_unit, format_quantity, unit_mixup_hint, Unit, DIMENSIONS, SHOWN_IN,
-DEG, DEG_S, DEG_H, ARCSEC, MM, HOUR, STANDARD_GRAVITY
+COUNT_EXAMPLES, DEG, DEG_S, DEG_H, ARCSEC, MM, HOUR, STANDARD_GRAVITY
 """
 
 from __future__ import annotations
@@ -247,6 +247,11 @@ def parse_quantity(text: str | float | int, expect: str, where: str | None = Non
 
 #: the unit readings of a dimension are shown in when they were given as a count size
 SHOWN_IN = {"magnetic_field": "uT", "angular_rate": "deg/s", "acceleration": "m/s^2"}
+#: per dimension of :data:`SHOWN_IN`: a count size, the same as a datasheet sensitivity, and the part and range
+#: they belong to (for messages that ask for one)
+COUNT_EXAMPLES = {"angular_rate": ("0.0076336 deg/s", "131 LSB/(deg/s)", "an MPU-6050 at +/-250 deg/s"),
+                  "acceleration": ("0.061035 mg", "16384 LSB/g", "an MPU-6050 at +/-2 g"),
+                  "magnetic_field": ("0.92 mG", "1090 LSB/gauss", "an HMC5883L at +/-1.3 gauss")}
 
 
 def parse_scale(text: str, expect: str, where: str | None = None) -> tuple[float, str]:
@@ -255,8 +260,10 @@ def parse_scale(text: str, expect: str, where: str | None = None) -> tuple[float
     Parameters
     ----------
     text : str
-        ``"uT"``, ``"gauss"``, ``"counts"`` (readings kept in counts), or a count size
-        such as ``"0.92 mG"`` (one count is that much).
+        ``"uT"``, ``"gauss"``, ``"deg/s"``; ``"counts"`` (readings kept in counts); the size of one
+        count: ``"0.92 mG"``, ``"0.0076336 deg/s"`` (one count is that much) or ``"0.0076336 deg/s/LSB"``;
+        or a datasheet sensitivity, counts per unit: ``"131 LSB/(deg/s)"``, ``"16384 LSB/g"`` (one count
+        is 1/131 deg/s, 1/16384 g).
     expect : str
         A key of :data:`DIMENSIONS` with an entry in :data:`SHOWN_IN`.
     where : str, optional
@@ -265,16 +272,37 @@ def parse_scale(text: str, expect: str, where: str | None = None) -> tuple[float
     Returns
     -------
     factor : float
-        Multiplies a reading into SI (or counts).
+        Multiplies a reading into SI (or counts): the count size in SI, ``1 / (sensitivity in SI)``.
     shown : str
-        The unit the scaled readings are shown and written in.
+        The unit the scaled readings are shown and written in: ``text`` for a unit or ``counts``,
+        :data:`SHOWN_IN` of the dimension for a count size or sensitivity.
+
+    Raises
+    ------
+    UnitError
+        Another dimension, or a count size or sensitivity that is not a finite number > 0.
     """
-    if text[:1].isdigit() or text[:1] == ".":
-        return parse_quantity(text, expect, where), SHOWN_IN[expect]
-    unit = parse_unit(text, where=where)
-    if unit.dim not in (DIMENSIONS[expect][0].dim, DIMENSIONS["counts"][0].dim):
-        raise UnitError(f"'{literal(text)}' is not {DIMENSIONS[expect][1]}, 'counts' or the size of one count", where)
-    return unit.factor, text
+    want, example = DIMENSIONS[expect]
+    count = DIMENSIONS["counts"][0].dim
+    m = _NUMBER.match(text)
+    if m is None:
+        unit = parse_unit(text, where=where)
+        if unit.dim not in (want.dim, count):
+            raise UnitError(f"'{literal(text)}' is not {example}, 'counts' or the size of one count", where)
+        return unit.factor, text
+    value, unit = float(m.group(1)), parse_unit(m.group(2).strip(), where=where)
+    per_count = tuple(a - b for a, b in zip(want.dim, count))
+    if unit.dim in (want.dim, per_count):   # '0.0076336 deg/s', '0.0076336 deg/s/LSB': one count is that much
+        size = value * unit.factor
+    elif unit.dim == tuple(-d for d in per_count):   # '131 LSB/(deg/s)': counts per unit
+        size = 1.0 / (value * unit.factor) if value else math.inf
+    else:
+        size_example, sensitivity_example, _ = COUNT_EXAMPLES[expect]
+        raise UnitError(f"'{literal(text)}' is neither the size of one count ({example.split(', e.g. ')[0]}, e.g. "
+                        f"'{size_example}') nor counts per unit (e.g. '{sensitivity_example}')", where)
+    if not (math.isfinite(size) and size > 0):
+        raise UnitError(f"'{literal(text)}': the size of one count must be a finite number > 0", where)
+    return size, SHOWN_IN[expect]
 
 
 def to_unit(value_si: float | np.ndarray, unit: str) -> float | np.ndarray:

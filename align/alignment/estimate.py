@@ -8,6 +8,13 @@ lengths); :func:`fit_rate_pairs` (Eq 28-30) and :func:`fit_angle_pairs` (Eq 31) 
 forms of the source, which it reproduces on their designs; :func:`two_axis` is the orthogonal
 shortcut (Eq 35-36).
 
+Each estimate is linear, ``x = L y`` (Eq E1), and its covariance is propagated through ``L`` (Eq E2): the
+noise inside the segments and, when the observations carry the bias-drift model
+(:class:`~align.alignment.drift.DriftObservation`, from :func:`~align.alignment.drift.with_drift`), the
+bias change between the segments (Eq D2); the bias is then the session bias, the mean of ``b(t)`` over the
+samples of the segments used. When the residuals scatter more than the model predicts (Eq E3) the
+covariance is inflated by the ratio.
+
 Public names
 ------------
 Fit, condition_number, fit_lsq, fit_rate_pairs, fit_angle_pairs, alignment_sigma
@@ -16,10 +23,11 @@ Fit, condition_number, fit_lsq, fit_rate_pairs, fit_angle_pairs, alignment_sigma
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from align.alignment.drift import DriftObservation
 from align.alignment.observe import Observation
 from align.alignment.plan import Plan, axis_name
 from align.errors import TestError
@@ -90,8 +98,9 @@ def fit_lsq(obs: list[Observation], rate_accuracy: float = 0.0, method: str = "l
     """General weighted least squares for ``[M | b]`` (extends Eq 28-31).
 
     Each gyro ``i`` is fitted separately: minimise ``sum_k (y_ki - phi_k . x_i)^2 / var_ki``. The
-    covariance is ``(Phi^T W Phi)^-1``, inflated by ``chi2 / dof`` when that exceeds 1 (the scatter
-    between segments is larger than the noise inside them, e.g. bias drift); a stated relative table
+    covariance is that of ``x = L y``, ``L = (Phi^T W Phi)^-1 Phi^T W`` (Eq E1-E2; ``(Phi^T W Phi)^-1`` without
+    drift), inflated by ``chi2 / E[chi2]`` when that exceeds 1 (Eq E3; ``E[chi2] = dof`` without drift: the
+    scatter between segments is larger than the noise and drift inside them); a stated relative table
     accuracy (rate, or angle over the turn) adds ``(M_ij rate_accuracy)^2``.
     Columns of ``M`` for axes never turned about are left NaN (the two-axis shortcut fills them).
     With ``equal_weights`` it is ordinary least squares, ``K = Y X^T (X X^T)^-1`` (reference
@@ -104,6 +113,7 @@ def fit_lsq(obs: list[Observation], rate_accuracy: float = 0.0, method: str = "l
         From :func:`observe`: ``y`` (3,) a mean reading (rad/s; m/s^2 for an accelerometer)
         or a turn's integrated reading (rad); ``phi`` (4,) ``[w u; 1]``, ``[0; 1]`` or
         ``[theta u; T]``; ``var`` (3,) the variance of ``y``. Static periods or +/- pairs fix ``b``.
+        :class:`~align.alignment.drift.DriftObservation` s also carry the bias drift (Eq D2-D3).
     rate_accuracy : float
         Relative table accuracy (rate, or angle over the turn), dimensionless; 0 adds nothing.
     method : str
@@ -128,6 +138,7 @@ def fit_lsq(obs: list[Observation], rate_accuracy: float = 0.0, method: str = "l
     chi2, resid = np.empty(3), np.empty((k, 3))
     dof = k - len(active)
     sub = np.ix_(active, active)
+    errors = _errors(obs)
     for i in range(3):
         wts = 1.0 / var[:, i]
         a = phi[:, active] * np.sqrt(wts)[:, None]
@@ -138,9 +149,10 @@ def fit_lsq(obs: list[Observation], rate_accuracy: float = 0.0, method: str = "l
         chi2[i] = float(np.sum(resid[:, i] ** 2 * wts))
         if equal_weights:
             inflate = chi2[i] / dof if dof > 0 else np.nan
+            cov[i][sub] = np.linalg.inv(a.T @ a) * inflate
         else:
-            inflate = max(1.0, chi2[i] / dof) if dof > 0 else 1.0
-        cov[i][sub] = np.linalg.inv(a.T @ a) * inflate
+            lmap = np.linalg.solve(a.T @ a, a.T * np.sqrt(wts)[None, :])  # x = L y (Eq E1)
+            cov[i][sub] = _propagate(lmap, phi, active, var[:, i], resid[:, i], dof, errors, i)
     m = x[:, :3]
     if rate_accuracy:
         for i in range(3):
@@ -170,7 +182,10 @@ def fit_rate_pairs(obs: list[Observation], plan: Plan) -> Fit:
     """Eq 28-30: ``M_ij = (g_i(+) - g_i(-)) / (w(+) - w(-))``, ``b = mean of (g(+) + g(-)) / 2``.
 
     With the table turning at ``+w`` and ``-w`` this is the source's ``(g(+) - g(-)) / (2 w)``; the
-    bias is the average over the three pairs of the pairwise bias, assuming equal rates.
+    bias is the average over the three pairs of the pairwise bias, assuming equal rates. The
+    uncertainty is that of the linear map ``x = L y`` (:func:`_propagate`): the noise of the two dwells
+    and, for :class:`~align.alignment.drift.DriftObservation` s, the bias change between them (Eq D2),
+    inflated by the scatter of the residuals (the pairwise biases) beyond what that predicts.
 
     Parameters
     ----------
@@ -184,21 +199,23 @@ def fit_rate_pairs(obs: list[Observation], plan: Plan) -> Fit:
     Returns
     -------
     Fit
-        ``M`` (3, 3), dimensionless, ``b`` (3,), rad/s, 1-sigma from the dwells' noise; ``chi2`` NaN.
+        ``M`` (3, 3), dimensionless, ``b`` (3,), rad/s, their covariance, ``chi2`` of the residuals.
     """
     pairs = _pairs(obs, plan, "rate")
-    m, var_m = np.empty((3, 3)), np.empty((3, 3))
-    biases, var_b = [], []
+    where = {id(o): k for k, o in enumerate(obs)}
+    lmap = np.zeros((4, len(obs)))
+    m = np.empty((3, 3))
+    biases = []
     for a, (p, n) in pairs.items():
         span = p.phi[a] - n.phi[a]
         m[:, a] = (p.y - n.y) / span
-        var_m[:, a] = (p.var + n.var) / span**2
         wp, wn = p.phi[a], n.phi[a]
         biases.append((p.y * wn - n.y * wp) / (wn - wp))
-        var_b.append((p.var * wn**2 + n.var * wp**2) / (wn - wp) ** 2)
+        lmap[a, where[id(p)]], lmap[a, where[id(n)]] = 1.0 / span, -1.0 / span
+        lmap[3, where[id(p)]] += wn / (wn - wp) / len(pairs)
+        lmap[3, where[id(n)]] -= wp / (wn - wp) / len(pairs)
     bias = np.mean(biases, axis=0)
-    sigma_b = np.sqrt(np.sum(var_b, axis=0)) / 3.0
-    return _closed_form_fit(obs, m, bias, np.sqrt(var_m), sigma_b, "rate")
+    return _closed_form_fit(obs, m, bias, lmap, "rate")
 
 
 def fit_angle_pairs(obs: list[Observation], plan: Plan) -> Fit:
@@ -206,6 +223,10 @@ def fit_angle_pairs(obs: list[Observation], plan: Plan) -> Fit:
 
     The bias cancels when both turns last equally long; otherwise the static periods' mean bias is removed
     first and reported (with no static period, the pairwise bias assuming equal durations is reported).
+    The uncertainty is that of the linear map ``x = L y`` (:func:`_propagate`): the turns' noise, the
+    static bias' own error times ``T(+) - T(-)`` and, for :class:`~align.alignment.drift.DriftObservation` s,
+    the bias change between the turns and the static periods times ``T`` (Eq D2), inflated by the
+    scatter of the residuals beyond what that predicts.
 
     Parameters
     ----------
@@ -220,40 +241,109 @@ def fit_angle_pairs(obs: list[Observation], plan: Plan) -> Fit:
     Returns
     -------
     Fit
-        ``M`` (3, 3), dimensionless, ``b`` (3,), rad/s (sigma NaN without a static period); ``chi2`` NaN.
+        ``M`` (3, 3), dimensionless, ``b`` (3,), rad/s (sigma NaN without a static period); ``chi2`` of the residuals.
     """
     pairs = _pairs(obs, plan, "angle")
+    where = {id(o): k for k, o in enumerate(obs)}
+    lmap = np.zeros((4, len(obs)))
     statics = [o for o in obs if o.segment.kind == "static"]
     if statics:
         w = np.array([o.duration for o in statics])
         bias = np.average([o.y for o in statics], axis=0, weights=w)
-        sigma_b = np.sqrt(np.sum([o.var * wi**2 for o, wi in zip(statics, w)], axis=0)) / w.sum()
+        bias_row = np.zeros(len(obs))
+        bias_row[[where[id(o)] for o in statics]] = w / w.sum()
+        lmap[3] = bias_row
     else:
-        bias, sigma_b = None, None
-    m, var_m = np.empty((3, 3)), np.empty((3, 3))
+        bias = None
+    m = np.empty((3, 3))
     pair_bias = []
     for a, (p, n) in pairs.items():
         span = p.phi[a] - n.phi[a]
         yp, yn = p.y, n.y
         if bias is not None:
             yp, yn = yp - bias * p.duration, yn - bias * n.duration
+            lmap[a] -= (p.duration - n.duration) / span * lmap[3]
         else:
             pair_bias.append((p.y + n.y) / (p.duration + n.duration))
+            lmap[3, [where[id(p)], where[id(n)]]] += 1.0 / (p.duration + n.duration) / len(pairs)
         m[:, a] = (yp - yn) / span
-        var_m[:, a] = (p.var + n.var) / span**2
-    if bias is None:
-        bias = np.mean(pair_bias, axis=0)
-        sigma_b = np.full(3, np.nan)
-    return _closed_form_fit(obs, m, bias, np.sqrt(var_m), sigma_b, "angle")
+        lmap[a, where[id(p)]] += 1.0 / span
+        lmap[a, where[id(n)]] -= 1.0 / span
+    fit = _closed_form_fit(obs, m, np.mean(pair_bias, axis=0) if bias is None else bias, lmap, "angle")
+    if statics:
+        return fit
+    cov = fit.cov.copy()
+    cov[:, 3, :], cov[:, :, 3] = np.nan, np.nan
+    return replace(fit, cov=cov, sigma_bias=np.full(3, np.nan))
 
 
-def _closed_form_fit(obs, m, bias, sigma_m, sigma_b, method) -> Fit:
-    phi, y, _ = _design(obs)
+def _closed_form_fit(obs: list[Observation], m: np.ndarray, bias: np.ndarray, lmap: np.ndarray, method: str) -> Fit:
+    """A closed form's :class:`Fit`: residuals, ``chi2`` and the covariance of ``x = L y``, ``lmap`` (4, k)."""
+    phi, y, var = _design(obs)
     resid = y - phi @ np.hstack([m, bias[:, None]]).T
-    cov = np.zeros((3, 4, 4))
-    for i in range(3):
-        cov[i] = np.diag(np.append(sigma_m[i], sigma_b[i]) ** 2)
-    return Fit(m, bias, sigma_m, sigma_b, cov, resid, len(obs) - 4, np.full(3, np.nan), condition_number(phi), method)
+    dof = len(obs) - 4
+    errors = _errors(obs)
+    cov = np.array([_propagate(lmap, phi, np.arange(4), var[:, i], resid[:, i], dof, errors, i) for i in range(3)])
+    sig = np.sqrt(np.einsum("ijj->ij", cov))
+    chi2 = np.sum(resid**2 / var, axis=0)
+    return Fit(m, bias, sig[:, :3], sig[:, 3], cov, resid, dof, chi2, condition_number(phi), method)
+
+
+def _errors(obs: list[Observation]) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
+    """The observations' noise variances (k, 3) and, when they carry a drift model (all
+    :class:`~align.alignment.drift.DriftObservation`), its generalised covariance ``G`` (3, k, k) of the
+    segments' mean biases (Eq D2) and the session weights ``tau`` (k,), ``T_k / sum T``."""
+    if obs and all(isinstance(o, DriftObservation) for o in obs):
+        spans = np.array([o.span for o in obs])
+        durations = spans[:, 1] - spans[:, 0]
+        return np.array([o.noise_var for o in obs]), obs[0].drift.covariance(spans), durations / durations.sum()
+    return np.array([o.var for o in obs]), None, None
+
+
+def _propagate(lmap: np.ndarray, phi: np.ndarray, active: np.ndarray, var: np.ndarray, resid: np.ndarray, dof: int,
+               errors: tuple, i: int) -> np.ndarray:
+    """Covariance of one gyro's ``x = L y`` (Eq E1-E3), inflated by the residuals' excess scatter.
+
+    The error of ``x`` is ``L n + A bbar`` with ``n`` the noise inside the segments and ``bbar`` their mean
+    biases, ``A = L diag(phi_3)`` minus the session weights ``tau`` in the bias row (the bias is reported about
+    the session bias ``sum tau_k bbar_k``; every row of ``A`` then sums to zero, as Eq D2 needs):
+    ``cov = L N L^T + A G A^T`` (E2). The residuals ``r = (I - Phi L) y`` have the expected weighted sum of
+    squares ``E = sum_k R_kk / var_k`` with ``R`` likewise (E3; ``E = dof`` for weighted least squares without
+    drift); when ``dof > 0``, ``cov`` is multiplied by ``max(1, chi2 / E)``.
+
+    Parameters
+    ----------
+    lmap : ndarray, shape (p, k)
+        ``L``: the estimate of the active parameters (the bias last) from the observations.
+    phi : ndarray, shape (k, 4)
+        The design; ``phi[:, active]`` (k, p).
+    active : ndarray of int, shape (p,)
+    var, resid : ndarray, shape (k,)
+        The weights' variances and the residuals of this gyro.
+    dof : int
+    errors : tuple
+        From :func:`_errors`.
+    i : int
+        The gyro.
+
+    Returns
+    -------
+    ndarray, shape (p, p)
+    """
+    noise, g, tau = errors
+    proj = np.eye(len(var)) - phi[:, active] @ lmap
+    cov = (lmap * noise[:, i]) @ lmap.T
+    r_var = np.einsum("kj,j,kj->k", proj, noise[:, i], proj)
+    if g is not None:
+        a = lmap * phi[:, 3]
+        a[-1] -= tau
+        cov = cov + a @ g[i] @ a.T
+        pa = proj * phi[:, 3]
+        r_var = r_var + np.einsum("kj,jl,kl->k", pa, g[i], pa)
+    expect = float(np.sum(r_var / var))
+    if dof > 0 and expect > 0:
+        cov = cov * max(1.0, float(np.sum(resid**2 / var)) / expect)
+    return cov
 
 
 def alignment_sigma(m: np.ndarray, cov: np.ndarray) -> np.ndarray:

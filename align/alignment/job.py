@@ -23,6 +23,7 @@ from align.alignment.checks import (
     check_scale,
     check_span,
 )
+from align.alignment.drift import estimate_drift, with_drift
 from align.alignment.estimate import alignment_sigma, fit_angle_pairs, fit_lsq, fit_rate_pairs
 from align.alignment.geometry import mounting_label
 from align.alignment.match import Candidate, match_steps
@@ -188,6 +189,8 @@ def align(
               check_saturation(g, segments, options.gyro_range, units)]
     earth = options.earth_correction and plan.latitude is not None
     obs, earth_model = observe(t, g, segments, plan, sigma, earth, nominal, [(c.start, c.end) for c in found.unclaimed])
+    drift = estimate_drift(obs, t, sigma, nominal)  # the bias change between segments, from the static periods
+    obs = with_drift(obs, drift, t, sigma)
     statics = [o for o in obs if o.segment.kind == "static"]
     rough_bias = (np.mean([o.y for o in statics], axis=0) if statics else np.zeros(3))
     checks.append(check_directions(_measured_turns(obs, plan, rough_bias, nominal), plan, options.rate_tolerance, units,
@@ -198,7 +201,7 @@ def align(
         fit = fit_angle_pairs(obs, plan)
     else:
         fit = fit_lsq(obs, _table_accuracy(plan), method)
-    notes = [_mounting_note(nominal, found.source)]
+    notes = [_mounting_note(nominal, found.source), drift.note]
     assumed = None
     if method == "two-axis":
         fit, assumed, note = _complete_two_axis(fit, missing, nominal, options)

@@ -29,7 +29,7 @@ from align.alignment.geometry import SIGNED_PERMUTATIONS, mounting_label
 from align.alignment.plan import Plan, Step, axis_name
 from align.errors import HandednessError, TestError
 from align.model import nearest_rotation
-from align.units import format_quantity
+from align.units import format_quantity, unit_mixup_hint
 
 #: largest relative distance |v - e| / |e| of a motion from a step's expected reading (90 deg apart is 1.41)
 MATCH_TOLERANCE = 0.35
@@ -107,22 +107,24 @@ def _find(step: Step, cands: list[Candidate], pos: int, e: np.ndarray, tol: floa
 
 def _greedy(plan: Plan, cands: list[Candidate], n: np.ndarray, tol: float):
     """Match the steps in order under mounting ``n``: (ranges, used candidate indices, cost, first unmatched step,
-    position reached)."""
-    pos, ranges, used, cost = 0, [], set(), 0.0
+    position reached, first departure ``(step, position)`` where a motion was skipped, or None)."""
+    pos, ranges, used, cost, departed = 0, [], set(), 0.0, None
     for k, step in enumerate(plan.steps):
         found = _find(step, cands, pos, _expected(step, n), tol)
         if found is None:
-            return ranges, used, cost, k, pos
+            return ranges, used, cost, k, pos, departed
         j, width, d = found
+        if j > pos and departed is None:
+            departed = (k, pos)
         ranges.append((cands[j].start, cands[j + width - 1].end))
         used.update(range(j, j + width))
         cost += d
         pos = j + width
-    return ranges, used, cost, None, pos
+    return ranges, used, cost, None, pos, departed
 
 
 def match_steps(plan: Plan, cands: list[Candidate], describe, where: str = "log",
-                tolerance: float = MATCH_TOLERANCE) -> Match:
+                tolerance: float = MATCH_TOLERANCE, sizes: list[float] | None = None) -> Match:
     """Find each plan step among the candidates, in order, with the declared or a detected mounting.
 
     Parameters
@@ -137,6 +139,9 @@ def match_steps(plan: Plan, cands: list[Candidate], describe, where: str = "log"
         Name of the log.
     tolerance : float
         Largest ``|v - e| / |e|`` of a match.
+    sizes : list of float, optional
+        The sizes of every motion seen (rad/s or rad), for the unit mix-up test when steps are not found;
+        the candidates' sizes when None.
 
     Returns
     -------
@@ -145,46 +150,59 @@ def match_steps(plan: Plan, cands: list[Candidate], describe, where: str = "log"
     Raises
     ------
     HandednessError
-        When only a mirrored mounting finds every step (a gyro reads backwards, ``det(M) < 0``).
+        When the nominal mounting with one gyro reversed finds every step (``det(M) < 0``).
     TestError
-        Naming the first planned step that cannot be found, and why (turned the wrong way, about another
-        axis, an IMU mounted at an angle that is not declared).
+        A unit mix-up (every motion about 57.3 or 1000 times the plan's), or naming the first planned step
+        that cannot be found, and why (turned the wrong way, about another axis, an IMU mounted at an angle
+        that is not declared).
     """
     declared = plan.nominal
     hypotheses = [declared] if declared is not None else list(SIGNED_PERMUTATIONS)
     best = None
     for n in hypotheses:
-        ranges, used, cost, missing, pos = _greedy(plan, cands, n, tolerance)
+        ranges, used, cost, missing, pos, departed = _greedy(plan, cands, n, tolerance)
         # a full match wins; among partial ones (for the message) the one that got furthest skipping least, with
         # a prior for the identity (a non-identity mounting must explain three more steps to be preferred)
         prior = 0 if declared is not None or np.allclose(n, np.eye(3)) else 3
         key = (missing is None, len(ranges) - 2 * (pos - len(used)) - prior, -cost)
         if best is None or key > best[0]:
-            best = (key, n, ranges, used, missing, pos)
-    _, n, ranges, used, missing, pos = best
+            best = (key, n, ranges, used, missing, pos, departed)
+    _, n, ranges, used, missing, pos, departed = best
     if missing is None:
         source = "declared" if declared is not None else "detected"
         return Match(tuple(ranges), tuple(c for j, c in enumerate(cands) if j not in used), n, source)
+    _refuse_mixup(plan, [float(np.linalg.norm(c.vector)) for c in cands] if sizes is None else sizes, where)
+    _refuse_mirrored(plan, cands, np.eye(3) if declared is None else declared, tolerance, where)
     if declared is None:
-        _refuse_mirrored(plan, cands, tolerance, where)
         _refuse_unaligned(plan, cands, where)
-    raise _not_found(plan, missing, cands, pos, n, describe, declared is not None, where)
+    raise _not_found(plan, missing, departed, cands, pos, n, describe, declared is not None, where)
 
 
-def _refuse_mirrored(plan: Plan, cands: list[Candidate], tol: float, where: str) -> None:
-    """A mirrored mounting that finds every step: one gyro reads backwards. Only said when the axis that gyro
-    measures was turned both ways (with one direction only, a turn the wrong way looks the same)."""
+def _refuse_mixup(plan: Plan, sizes: list[float], where: str) -> None:
+    """The motions are all about 57.3 or 1000 times the plan's: a unit mixed up (:func:`align.units.unit_mixup_hint`)."""
+    if not sizes:
+        return
+    biggest = sorted(sizes)[-len(plan.steps):]
+    planned = [abs(s.rate if s.rate is not None else s.angle) for s in plan.steps]
+    hint = unit_mixup_hint(float(np.median(biggest)) / float(np.median(planned)))
+    if hint:
+        raise TestError(hint, where)
+
+
+def _refuse_mirrored(plan: Plan, cands: list[Candidate], proper: np.ndarray, tol: float, where: str) -> None:
+    """The nominal mounting (``proper``: the declared one or the identity) with one gyro reversed finds every step:
+    that gyro reads backwards. Only said when the axis it measures was turned both ways (with one direction only, a
+    turn the wrong way looks the same)."""
     both = {a for a in range(3) if len({np.sign((s.rate if s.rate is not None else s.angle) * s.sign)
                                          for s in plan.steps if s.axis == a}) == 2}
-    for proper in SIGNED_PERMUTATIONS:
-        for i in range(3):
-            flip = proper.copy()
-            flip[i] *= -1
-            if int(np.argmax(np.abs(flip[i]))) in both and _greedy(plan, cands, flip, tol)[3] is None:
-                raise HandednessError(
-                    f"the steps are found only if gyro {'xyz'[i]} reads backwards: the {'xyz'[i]} gyro reads backwards "
-                    "(det(M) < 0, a handedness error) or the plan's axis signs are wrong; fix the wiring or sign, "
-                    "the tool does not flip it", where)
+    for i in range(3):
+        flip = proper.copy()
+        flip[i] *= -1
+        if int(np.argmax(np.abs(flip[i]))) in both and _greedy(plan, cands, flip, tol)[3] is None:
+            raise HandednessError(
+                f"the steps are found only if gyro {'xyz'[i]} reads backwards: the {'xyz'[i]} gyro reads backwards "
+                "(det(M) < 0, a handedness error) or the plan's axis signs are wrong; fix the wiring or sign, "
+                "the tool does not flip it", where)
 
 
 def _refuse_unaligned(plan: Plan, cands: list[Candidate], where: str) -> None:
@@ -218,33 +236,46 @@ def _refuse_unaligned(plan: Plan, cands: list[Candidate], where: str) -> None:
                     f"[mounting] matrix = [{rows}]", where)
 
 
-def _not_found(plan: Plan, k: int, cands: list[Candidate], pos: int, n: np.ndarray, describe, declared: bool,
-               where: str) -> TestError:
-    """The error for step ``k`` that could not be found: why, judged on the next motion in the log."""
+def _label(plan: Plan, k: int) -> str:
+    return f"step {k + 1} ({plan.steps[k].label})"
+
+
+def _why(plan: Plan, k: int, cands: list[Candidate], pos: int, n: np.ndarray, describe, declared: bool) -> str | None:
+    """Why step ``k`` is not the motion at ``pos`` (turned about another axis, the wrong way, off in size); None when
+    no motion is left."""
+    if pos >= len(cands):
+        return None
     step = plan.steps[k]
-    label = f"step {k + 1} ({step.label})"
-    after = f"after step {k}" if k else "in the log"
-    rest = cands[pos:]
-    if not rest:
-        listed = "; ".join(describe(c) for c in cands) or "none"
-        return TestError(f"{label} not found {after}: no motion left in the log (motions found: {listed}); check the "
-                         "plan against the log, or give {segments}", where)
     e = _expected(step, n)
-    nxt = rest[0]
-    v = nxt.vector
+    v = cands[pos].vector
     along = float(v @ e / np.linalg.norm(e))
     across = float(np.linalg.norm(v - along * e / np.linalg.norm(e)))
-    seen = describe(nxt)
+    seen = describe(cands[pos])
     unit = "deg/s" if step.rate is not None else "deg"
     said = f"planned {format_quantity(step.rate if step.rate is not None else step.angle, unit, 5)} about " \
            f"{axis_name(step.axis, step.sign)}"
     if across > 0.5 * abs(along):
         mount = "the declared mounting" if declared else f"the mounting {mounting_label(n)}"
-        why = (f"the next motion ({seen}) turned about another axis than {mount} expects; check the fixture "
-               "orientation, the step's axis or the plan's [mounting]")
-    elif along < 0:
-        why = f"the next motion ({seen}) turned the wrong way; re-run the step or correct its sign in the plan"
-    else:
-        why = (f"the next motion ({seen}) is off by {100 * (along / np.linalg.norm(e) - 1):+.1f} %: wrong table rate or "
-               "angle, or a wrong plan step")
-    return TestError(f"{label} not found {after} ({said}): {why}", where)
+        return (f"{said}, the next motion ({seen}) turned about another axis than {mount} expects; check the fixture "
+                "orientation, the step's axis or the plan's [mounting]")
+    if along < 0:
+        return f"{said}, the next motion ({seen}) turned the wrong way; re-run the step or correct its sign in the plan"
+    return (f"{said}, the next motion ({seen}) is off by {100 * (along / np.linalg.norm(e) - 1):+.1f} %: wrong table "
+            "rate or angle, or a wrong plan step")
+
+
+def _not_found(plan: Plan, missing: int, departed: tuple[int, int] | None, cands: list[Candidate], pos: int,
+               n: np.ndarray, describe, declared: bool, where: str) -> TestError:
+    """The error for the step that could not be found; when motions were skipped before it, where the log first left
+    the plan (the step named there, and why, judged on the motion that came instead)."""
+    if departed is not None:
+        k, at = departed
+        return TestError(f"the log departs from the plan at {_label(plan, k)}: "
+                         f"{_why(plan, k, cands, at, n, describe, declared)}; {_label(plan, missing)} is not found at all",
+                         where)
+    after = f"after step {missing}" if missing else "in the log"
+    why = _why(plan, missing, cands, pos, n, describe, declared)
+    if why is None:
+        listed = "; ".join(describe(c) for c in cands) or "none"
+        why = f"no motion left in the log (motions found: {listed}); check the plan against the log, or give {{segments}}"
+    return TestError(f"{_label(plan, missing)} not found {after}: {why}", where)

@@ -21,9 +21,9 @@ import numpy as np
 
 from align.alignment.match import Candidate, match_steps
 from align.alignment.plan import Plan
-from align.errors import InputError, TestError, literal
+from align.errors import InputError, literal
 from align.io.keys import check_keys, require_keys
-from align.units import DEG, DEG_S, unit_mixup_hint
+from align.units import DEG, DEG_S
 
 
 @dataclass(frozen=True)
@@ -326,15 +326,8 @@ def segment_log(
         cands = [Candidate("rate", a, b, np.mean(g[a:b], axis=0) - bias) for a, b in moving]
     else:
         cands = turns
-    try:
-        match = match_steps(plan, cands, _describer(t), where)
-    except TestError:
-        sizes = sorted(float(np.linalg.norm(c.vector)) for c in cands)[-len(plan.steps):]
-        planned = [abs(s.rate if s.rate is not None else s.angle) for s in plan.steps]
-        hint = unit_mixup_hint(float(np.median(sizes)) / float(np.median(planned))) if sizes else None
-        if hint:
-            raise TestError(hint, where) from None
-        raise
+    sizes = [float(np.linalg.norm(np.mean(g[a:b], axis=0) - bias)) for a, b in runs] if plan.kind == "rate" else None
+    match = match_steps(plan, cands, _describer(t), where, sizes=sizes)
     segs = [Segment(f"step {k + 1} ({s.label})", s.kind, a, b, k) for k, (s, (a, b)) in enumerate(zip(plan.steps, match.ranges))]
     segs += [Segment(f"static {k + 1}", "static", a, b) for k, (a, b) in enumerate(statics)]
     unclaimed = list(match.unclaimed)

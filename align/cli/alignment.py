@@ -2,7 +2,7 @@
 
 Public names
 ------------
-matrix, apply, GYRO_COLUMNS, SENSOR_COLUMNS, COMMANDS
+matrix, apply, GYRO_COLUMNS, SENSOR_COLUMNS, SENSOR_DIMENSIONS, COMMANDS
 """
 
 
@@ -16,6 +16,8 @@ GYRO_COLUMNS = "time,gyro_x,gyro_y,gyro_z"
 #: the columns ``apply`` reads by default, per sensor
 SENSOR_COLUMNS = {"gyroscope": GYRO_COLUMNS, "accelerometer": "time,acc_x,acc_y,acc_z",
                   "magnetometer": "time,mag_x,mag_y,mag_z"}
+#: the dimension of each sensor's readings (a key of ``align.units.DIMENSIONS``)
+SENSOR_DIMENSIONS = {"gyroscope": "angular_rate", "accelerometer": "acceleration", "magnetometer": "magnetic_field"}
 
 Log = opt.Arg("Gyro log: .csv, .csv.gz, .npy or .parquet.", "LOG")
 
@@ -51,6 +53,10 @@ def matrix(
     two_axis_variant: opt.Choice("--two-axis-variant", ("procrustes", "cross"),
                              "Two-axis shortcut: procrustes, or cross (the source's Eq 36).") = "procrustes",
     earth: opt.Flag("--earth/--no-earth", "Correct the vertical Earth rate when the plan gives a latitude.") = True,
+    skip_rows: opt.SkipRows = 0,
+    comment: opt.Comment = None,
+    delimiter: opt.Delimiter = None,
+    time_units: opt.TimeUnits = None,
 ) -> None:
     """Alignment matrix M and A = M^-1 from rate-table data."""
     check_outputs([log, plan, segments], json_out=json_out, c_header=c_header)
@@ -61,16 +67,19 @@ def matrix(
     from align.present.text import alignment_summary
 
     time_col, cols = split_columns(columns, rate_hz)
+    fmt = opt.log_format(skip_rows, comment, delimiter, time_units)
     the_plan = Plan.from_dict(fileio.read_toml(plan), str(plan))
-    t, g = fileio.read_log(log, cols, gyro_units, time_col, rate_hz)
+    got = fileio.read_sensor_log(log, cols, gyro_units, time_col, rate_hz, log_format=fmt)
+    t, g = got.t, got.data
     opts = AlignOptions(method=value(method), two_axis_variant=value(two_axis_variant), axis_to_axis=axis_to_axis,
                         segmentation=SegmentOptions(window_s=window, margin_s=margin, static_threshold=static_threshold),
                         min_dwell=min_dwell, rate_tolerance=rate_tolerance, scale_tolerance=scale_tolerance,
                         gyro_range=gyro_range, earth_correction=earth)
     segs = None if segments is None else segments_from_ranges(fileio.read_json(segments), the_plan, len(t), str(segments))
-    result = align(t, g, the_plan, opts, segs, gyro_units, str(log))
+    result = align(t, g, the_plan, opts, segs, got.shown, str(log))
     result = result.replace(inputs={"log": str(log), "plan": str(plan), "gyro_units": gyro_units, "columns": columns,
-                                    "segments": None if segments is None else str(segments)})
+                                    "segments": None if segments is None else str(segments), **got.inputs()},
+                            notes=result.notes + ((got.time_note(),) if got.time_note() else ()))
     with outputs() as out:  # all or none
         if json_out is not None:
             out.write_json(json_out, result)
@@ -90,6 +99,10 @@ def apply(
     units: opt.Units("Unit of the columns for an accelerometer or magnetometer result (default: the result's).") = None,
     columns: opt.Columns("Column names: time,x,y,z (x,y,z with --rate-hz); default per sensor.", optional=True) = None,
     rate_hz: opt.RateHz() = None,
+    skip_rows: opt.SkipRows = 0,
+    comment: opt.Comment = None,
+    delimiter: opt.Delimiter = None,
+    time_units: opt.TimeUnits = None,
 ) -> None:
     """Correct a log: gyro w = A (g - b); accelerometer M^-1 (a - b); magnetometer soft_iron (m - hard_iron)."""
     check_outputs([log, alignment], out=out)
@@ -97,10 +110,12 @@ def apply(
 
     import align.io as fileio
     from align.errors import AlignError, UnitError, literal
+    from align.io.formats import TIME_UNITS
     from align.plausible import check_corrected
     from align.results import load_result
-    from align.units import parse_unit, to_unit
+    from align.units import DIMENSIONS, parse_unit
 
+    fmt = opt.log_format(skip_rows, comment, delimiter, time_units)
     correction = load_result(alignment).correction(value(sensor), str(alignment))
     kind = correction.sensor
     if units:
@@ -109,23 +124,32 @@ def apply(
         u, field = gyro_units, "gyro_units"
     else:
         u, field = correction.units, "units"
-    expect = "angular_rate" if kind == "gyroscope" else None
-    unit = parse_unit(u, expect, "{" + field + "}" if units or kind == "gyroscope" else f"{alignment}: units")
+    expect = SENSOR_DIMENSIONS[kind]
     try:
         own = parse_unit(correction.units).dim
-    except AlignError:  # the size of one count ('0.92 mG'): any unit of the log is the user's to state
-        own = unit.dim
-    if kind != "gyroscope" and unit.dim != own:
-        raise UnitError(f"'{literal(u)}' is not a unit of the {kind} data of {alignment} ({literal(correction.units)}); "
-                        f"give the log's unit, e.g. {{units={correction.units}}}", "{units}")
+    except AlignError:  # the size of one count ('0.92 mG'): the result holds readings of its dimension
+        own = DIMENSIONS[expect][0].dim
+    if own == DIMENSIONS["counts"][0].dim:
+        expect = "counts"
+    if kind != "gyroscope":
+        try:
+            given = parse_unit(u).dim
+        except AlignError:  # a count size or a sensitivity ('16384 LSB/g'): read below, against the result's kind
+            given = own
+        if given != own:
+            raise UnitError(f"'{literal(u)}' is not a unit of the {kind} data of {alignment} ({literal(correction.units)}); "
+                            f"give the log's unit, e.g. {{units={correction.units}}}", "{units}")
     time_col, cols = split_columns(columns or SENSOR_COLUMNS[kind], rate_hz)
-    t, raw = fileio.read_log(log, cols, u, time_col, rate_hz, expect=expect)
-    corrected = correction.correct(raw)
-    check_corrected(kind, corrected, u, field, str(log))  # a log read in the wrong unit is refused
+    got = fileio.read_sensor_log(log, cols, u, time_col, rate_hz, expect=expect, log_format=fmt, field=field)
+    factor, _ = fileio.sensor_scale(u, expect, field)
+    corrected = correction.correct(got.data)
+    check_corrected(kind, corrected, got.shown, field, str(log))  # a log read in the wrong unit is refused
     names = ([time_col] if time_col else []) + cols
+    t = got.t / TIME_UNITS[got.time_units] if got.time_units else got.t  # the time column as the log had it
     with outputs() as staged:
-        staged.write_csv(out, names, np.column_stack(([t] if time_col else []) + [to_unit(corrected, u)]))
-    typer.echo(f"wrote {out}: {len(t)} rows of {kind} data corrected with {alignment} ({u})")
+        staged.write_csv(out, names, np.column_stack(([t] if time_col else []) + [corrected / factor]))
+    typer.echo(f"wrote {out}: {len(t)} rows of {kind} data corrected with {alignment} ({u})"
+               + (f"; {got.time_note()}" if got.time_note() else ""))
 
 
 COMMANDS = {"matrix": matrix, "apply": apply}

@@ -25,13 +25,16 @@ def ferraris(
     gravity: opt.Quantity("--gravity", "acceleration", Gravity + ".", "ACCEL", POSITIVE, "'9.81 m/s^2'") = "9.80665 m/s^2",
     accel_columns: opt.Columns("Accelerometer columns.", "--accel-columns") = "acc_x,acc_y,acc_z",
     gyro_columns: opt.Columns("Gyro columns.", "--gyro-columns") = "gyr_x,gyr_y,gyr_z",
-    accel_units: opt.UnitFlag("--accel-units", "Accelerometer unit.") = "m/s^2",
+    accel_units: opt.UnitFlag("--accel-units", "Accelerometer unit, or the size of one count ('16384 LSB/g').") = "m/s^2",
     gyro_units: opt.GyroUnits("Gyro unit.") = "deg/s",
     bias: opt.Choice("--bias", ("pairwise", "lsq"), "Accelerometer bias: pairwise (Ferraris, tilt-robust) or lsq.") = "pairwise",
     g_sensitivity: opt.Flag("--g-sensitivity/--no-g-sensitivity",
                         "Estimate the gyro's g-sensitivity from the static faces.") = True,
     json_out: opt.JsonOut = None,
     imucal_json: opt.OptInput("--imucal-json", "Also write the result as imucal's JSON.", "FILE.json") = None,
+    skip_rows: opt.SkipRows = 0,
+    comment: opt.Comment = None,
+    delimiter: opt.Delimiter = None,
 ) -> None:
     """A Ferraris session (six static faces and a turn about each axis), as imucal records it."""
     check_outputs([log, sections], json_out=json_out, imucal_json=imucal_json)
@@ -40,13 +43,16 @@ def ferraris(
     from align.calibration import ferraris as compute
     from align.present.text import calibration_summary
 
-    _, acc = fileio.read_log(log, names(accel_columns), accel_units, None, rate_hz, expect="acceleration")
-    _, gyr = fileio.read_log(log, names(gyro_columns), gyro_units, None, rate_hz)
+    fmt = opt.log_format(skip_rows, comment, delimiter)
+    acc = fileio.read_sensor_log(log, names(accel_columns), accel_units, None, rate_hz, expect="acceleration",
+                                 log_format=fmt, field="accel_units")
+    gyr = fileio.read_sensor_log(log, names(gyro_columns), gyro_units, None, rate_hz, log_format=fmt)
     ranges = sections_from_dict(fileio.read_json(sections), str(sections))
-    acc_cal, gyr_cal = compute(acc, gyr, rate_hz, ranges, turn_angle, gravity, accel_units, gyro_units,
+    acc_cal, gyr_cal = compute(acc.data, gyr.data, rate_hz, ranges, turn_angle, gravity, acc.shown, gyr.shown,
                                pairwise_bias=value(bias) == "pairwise", g_sensitivity=g_sensitivity, where=str(log))
     result = CalibrationSet({"accelerometer": acc_cal, "gyroscope": gyr_cal},
-                            {"log": str(log), "sections": str(sections)})
+                            {"log": str(log), "sections": str(sections), "accel_units": accel_units,
+                             "gyro_units": gyro_units, **fmt.to_dict()})
     with outputs() as out:  # all or none
         if json_out is not None:
             out.write_json(json_out, result)
@@ -61,7 +67,8 @@ def accel(
                         "orientations are unknown and |a| = g is fitted.", "POSITIONS.toml") = None,
     columns: opt.Columns("Columns: time,x,y,z (x,y,z with --rate-hz).") = "time,acc_x,acc_y,acc_z",
     rate_hz: opt.RateHz() = None,
-    accel_units: opt.UnitFlag("--accel-units", "Unit of the readings (an acceleration, or 'counts').") = "m/s^2",
+    accel_units: opt.UnitFlag("--accel-units", "Unit of the readings (an acceleration), 'counts', or the "
+                                                "size of one count: '16384 LSB/g'.") = "m/s^2",
     gravity: opt.Text("--gravity", "acceleration", Gravity + " (default 9.80665 m/s^2, or the positions file's gravity).",
                       "ACCEL", POSITIVE, "'9.81 m/s^2'") = None,
     window: opt.Quantity("--window", "time", "Variance window of the static detector.", "TIME", DURATION, "'1 s'") = "1 s",
@@ -71,23 +78,28 @@ def accel(
                              "TIME", DURATION, "'50 s'") = None,
     min_static: opt.Quantity("--min-static", "time", "Shortest static interval.", "TIME", DURATION, "'1 s'") = "1 s",
     json_out: opt.JsonOut = None,
+    skip_rows: opt.SkipRows = 0,
+    comment: opt.Comment = None,
+    delimiter: opt.Delimiter = None,
+    time_units: opt.TimeUnits = None,
 ) -> None:
     """Accelerometer multi-position calibration (known orientations, or |a| = g over many attitudes)."""
     check_outputs([log, positions], json_out=json_out)
     import align.io as fileio
     from align.calibration import CalibrationSet, StaticDetector, calibrate_accel_log
     from align.present.text import calibration_summary
-    from align.units import parse_quantity, parse_unit
+    from align.units import parse_quantity
 
     time_col, cols = split_columns(columns, rate_hz)
-    counts = parse_unit(accel_units, where="{accel_units}").dim == parse_unit("counts").dim
-    t, a = fileio.read_log(log, cols, accel_units, time_col, rate_hz, expect="counts" if counts else "acceleration")
+    fmt = opt.log_format(skip_rows, comment, delimiter, time_units)
+    got = fileio.read_sensor_log(log, cols, accel_units, time_col, rate_hz, expect="acceleration", log_format=fmt,
+                                 counts=True)  # an accelerometer may be calibrated in its counts
     spec = fileio.read_toml(positions) if positions is not None else None
     g = None if gravity is None else parse_quantity(gravity, "acceleration", "{gravity}")
-    cal = calibrate_accel_log(t, a, spec, accel_units, g, StaticDetector(window, factor, init_static, min_static), str(log),
-                              str(positions))
-    result = CalibrationSet({"accelerometer": cal}, {"log": str(log),
-                                                     "positions": None if positions is None else str(positions)})
+    cal = calibrate_accel_log(got.t, got.data, spec, got.shown, g, StaticDetector(window, factor, init_static, min_static),
+                              str(log), str(positions))
+    result = CalibrationSet({"accelerometer": cal}, {"log": str(log), "positions": None if positions is None else
+                                                     str(positions), "accel_units": accel_units, **got.inputs()})
     with outputs() as out:
         if json_out is not None:
             out.write_json(json_out, result)
@@ -107,6 +119,9 @@ def mag(
     dip: opt.OptQuantity("--dip", "angle", "Magnetic dip for the heading-error prediction when no accelerometer "
                          "(-90 to 90 deg).", "ANGLE", DIP, "'60 deg'") = None,
     json_out: opt.JsonOut = None,
+    skip_rows: opt.SkipRows = 0,
+    comment: opt.Comment = None,
+    delimiter: opt.Delimiter = None,
 ) -> None:
     """Magnetometer hard and soft iron (ellipsoid fit with coverage gates)."""
     check_outputs([log], json_out=json_out)
@@ -117,8 +132,9 @@ def mag(
     from align.present.text import magnetometer_summary
     from align.units import parse_quantity, parse_scale
 
+    fmt = opt.log_format(skip_rows, comment, delimiter)
     scale, shown = parse_scale(mag_units, "magnetic_field", "{mag_units}")
-    _, data = fileio.read_columns(log, names(columns) + (names(accel_columns) if accel_columns else []))
+    _, data = fileio.read_columns(log, names(columns) + (names(accel_columns) if accel_columns else []), log_format=fmt)
     check_readings(data, str(log))
     m = data[:, :3] * scale
     acc = data[:, 3:6] if accel_columns else None
@@ -128,7 +144,7 @@ def mag(
     cal = calibrate_magnetometer(m, shown, f, value(model), acc, dip, where=str(log))
     if acc is not None:
         cal = with_gravity_alignment(cal, m, acc)
-    cal = cal.replace(inputs={"log": str(log), "columns": columns, "mag_units": mag_units})
+    cal = cal.replace(inputs={"log": str(log), "columns": columns, "mag_units": mag_units, **fmt.to_dict()})
     with outputs() as out:
         if json_out is not None:
             out.write_json(json_out, cal)

@@ -58,6 +58,10 @@ def allan(
     noise_ratio: NoiseRatio = 10.0,
     memory_limit_mb: opt.Number("--memory-limit-mb", "Phase kept in memory up to this size (MB); beyond it, a temporary "
                                 "file.", POSITIVE, "2000", "MB") = 2000.0,
+    skip_rows: opt.SkipRows = 0,
+    comment: opt.Comment = None,
+    delimiter: opt.Delimiter = None,
+    time_units: opt.TimeUnits = None,
 ) -> None:
     """Allan deviation, noise-model fit and noise figures of static recordings."""
     from align.errors import InputError
@@ -67,14 +71,11 @@ def allan(
     check_outputs(logs, json_out=json_out, plot=plot)
     from align.noise import plan_from_allan, read_runs, run_allan
     from align.present.text import allan_summary, plan_summary
-    from align.units import parse_unit
 
-    unit = units or gyro_units
-    parse_unit(unit, None if units else "angular_rate", "{units}" if units else "{gyro_units}")
-    if units and parse_unit(units).dim not in (parse_unit("rad/s").dim, parse_unit("m/s^2").dim):
-        raise InputError(f"'{units}' is neither an angular rate nor an acceleration", "{units}")
+    fmt = opt.log_format(skip_rows, comment, delimiter, time_units)
+    unit, scale = _allan_unit(gyro_units, units)
     channels = names(columns)
-    runs, fs = read_runs(logs, channels, rate_hz)
+    runs, fs = read_runs(logs, channels, rate_hz, fmt, scale)
     with progress(runs[0].shape[0], "Allan deviation (samples read)") as tick:
         job = run_allan(runs, fs, channels, unit, grid, per_decade, modified, progress=tick,
                         memory_limit=memory_limit_mb * 1e6, where=[str(p) for p in logs])
@@ -92,6 +93,32 @@ def allan(
     typer.echo(allan_summary(job))
     if job.plan is not None:
         typer.echo("\n" + plan_summary(job.plan))
+
+
+def _allan_unit(gyro_units: str, units: str | None) -> tuple[str, float]:
+    """The unit the deviations are shown in, and the size of one count in it (1: the logs hold that unit).
+
+    ``--gyro-units`` is an angular rate, ``--units`` an angular rate or an acceleration; either may be the
+    size of one count (``'0.0076336 deg/s'``, ``'131 LSB/(deg/s)'``, ``'16384 LSB/g'``): the deviations are
+    then shown in deg/s or m/s^2. Raw ``counts`` are refused with the advice to give the count size.
+    """
+    from align.errors import InputError, UnitError, literal
+    from align.io import sensor_scale
+    from align.units import parse_unit
+
+    if units is None:
+        factor, shown = sensor_scale(gyro_units, "angular_rate", "gyro_units")
+        return shown, factor / parse_unit(shown).factor
+    for expect in ("angular_rate", "acceleration"):
+        try:
+            factor, shown = sensor_scale(units, expect, "units")
+        except UnitError as exc:
+            if "raw counts" in exc.message:
+                raise
+            continue
+        return shown, factor / parse_unit(shown).factor
+    raise InputError(f"'{literal(units)}' is neither an angular rate nor an acceleration (nor the size of one count of either)",
+                     "{units}")
 
 
 def plan(

@@ -13,31 +13,58 @@ sample rate is a number of Hz or a frequency (``100``, ``'100 Hz'``), a quantity
 option arrives in SI (``'1 s'`` -> 1.0), a choice is checked before the command
 runs. Every value is checked for its domain where it is parsed (finite, and
 ``> 0``, ``>= 0`` or a range as the option states: :class:`Domain`); a refusal
-is a usage error naming the option and what to type. Nothing here imports
+is a usage error naming the option and what to type (the parsers and domains
+live in :mod:`align.cli.parsers`, re-exported here). Nothing here imports
 numpy or the library's heavy modules.
+
+A command that reads a log takes the logger file options :data:`SkipRows`,
+:data:`Comment`, :data:`Delimiter` (text logs) and :data:`TimeUnits` (a time
+column), and builds the library's ``LogFormat`` from them with :func:`log_format`.
 
 Public names
 ------------
 FLAGS, COMMAND_FLAGS, ALIASES, spell, speller, rewrite_aliases (the spelling of fields and flags);
 Domain, ANY, POSITIVE, NONNEGATIVE, NONZERO, ACCURACY, DURATION, PAUSE, TOLERANCE, DIP, MAX_RATE_HZ
 (the domains of values);
-hertz, quantity, checked_text, number, whole, split_columns, names, value (values at the edge);
+hertz, quantity, checked_text, number, whole, delimiter, comment, time_units, split_columns, names, value
+(values at the edge);
 JsonOut, Seed, MonteCarlo, RateHz, Quantity, OptQuantity, Text, Number, Whole, Choice, Columns, UnitFlag, GyroUnits,
-Units, Arg, Input, OptInput, Flag (typed options: ``name: Type = default``)
+Units, Arg, Input, OptInput, Flag, SkipRows, Comment, Delimiter, TimeUnits (typed options: ``name: Type = default``);
+log_format (the logger file options as the library's ``LogFormat``)
 """
 
 from __future__ import annotations
 
 import enum
-import math
 import shlex
 from collections.abc import Callable
-from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
 from typing import Annotated
 
 import typer
+
+from align.cli.parsers import (  # noqa: F401  (re-exported: the commands take them from here)
+    ACCURACY,
+    ANY,
+    DIP,
+    DURATION,
+    MAX_RATE_HZ,
+    NONNEGATIVE,
+    NONZERO,
+    PAUSE,
+    POSITIVE,
+    TOLERANCE,
+    Domain,
+    checked_text,
+    comment,
+    delimiter,
+    hertz,
+    number,
+    quantity,
+    time_units,
+    whole,
+)
 
 #: library field -> flag, where it is not ``--`` + the field with ``_`` as ``-``
 FLAGS: dict[str, str] = {
@@ -67,6 +94,12 @@ FLAGS: dict[str, str] = {
     "init_static_s": "--init-static",
     "min_duration_s": "--min-static",
     "acc": "--accel-columns",
+    # a logger file's format (align.io.formats.LogFormat): the default spelling, listed because every log reader
+    # names them
+    "skip_rows": "--skip-rows",
+    "comment": "--comment",
+    "delimiter": "--delimiter",
+    "time_units": "--time-units",
     # positional arguments
     "log": "LOG",
     "logs": "LOG...",
@@ -156,169 +189,6 @@ def value(choice) -> str:
     return getattr(choice, "value", choice)
 
 
-# ---- value parsers (a ValueError becomes a usage error naming the option) ----
-#
-# Every parser checks its value's domain where it is parsed: finite always, and the domain the
-# option states (``> 0``, ``>= 0``, a range). A refusal says what to type: ``give a time > 0, e.g. '10 s'``.
-
-_DEG = math.pi / 180.0
-#: the highest sample rate accepted, Hz (a MEMS IMU samples at kHz at most)
-MAX_RATE_HZ = 1e7
-
-
-@dataclass(frozen=True)
-class Domain:
-    """Where a number may lie: above ``low`` (``open_low``: strictly), up to ``high``, or anywhere but 0.
-
-    ``text`` is how the domain reads in a refusal (``"> 0"``, ``"within -90 deg and 90 deg"``).
-    """
-
-    text: str
-    low: float | None = None
-    high: float | None = None
-    open_low: bool = True
-    nonzero: bool = False
-
-    def holds(self, x: float) -> bool:
-        """``x`` is finite and inside the domain."""
-        if not math.isfinite(x) or (self.nonzero and x == 0):
-            return False
-        if self.low is not None and (x <= self.low if self.open_low else x < self.low):
-            return False
-        return self.high is None or x <= self.high
-
-
-#: any finite number
-ANY = Domain("")
-#: > 0
-POSITIVE = Domain("> 0", low=0.0)
-#: >= 0
-NONNEGATIVE = Domain(">= 0", low=0.0, open_low=False)
-#: any finite number but 0
-NONZERO = Domain("other than 0", nonzero=True)
-#: an alignment goal: (0, 90] deg
-ACCURACY = Domain("> 0 and <= 90 deg", low=0.0, high=90 * _DEG)
-#: a duration > 0 of at most a day (a moving window, a dwell, a static interval), s
-DURATION = Domain("> 0 and <= 86400 s (a day)", low=0.0, high=86400.0)
-#: a duration >= 0 of at most a day (a margin, a gap, a settling time), s
-PAUSE = Domain(">= 0 and <= 86400 s (a day)", low=0.0, high=86400.0, open_low=False)
-#: a relative tolerance: (0, 100 %]
-TOLERANCE = Domain("> 0 and <= 100 %", low=0.0, high=1.0)
-#: a magnetic dip: [-90, 90] deg
-DIP = Domain("within -90 deg and 90 deg", low=-90 * _DEG, high=90 * _DEG, open_low=False)
-
-
-def _give(what: str, domain: Domain, example: str) -> str:
-    """``give a time > 0, e.g. '10 s'``."""
-    return f"give {what}{' ' + domain.text if domain.text else ''}, e.g. {example}"
-
-
-def hertz(text: str | float) -> float:
-    """A sample rate: a bare number of Hz (``100``) or a frequency (``'100 Hz'``, ``'2 kHz'``), in Hz,
-    above 0 and at most :data:`MAX_RATE_HZ`."""
-    advice = "give a sample rate > 0 Hz and <= 1e7 Hz, e.g. 100 or '100 Hz'"
-    if isinstance(text, (int, float)):
-        value = float(text)
-    else:
-        try:
-            value = float(text)
-        except ValueError:
-            from align.errors import AlignError
-            from align.units import parse_quantity
-
-            try:
-                value = parse_quantity(text, "frequency")
-            except AlignError:
-                raise ValueError(advice) from None
-    if not (math.isfinite(value) and 0 < value <= MAX_RATE_HZ):
-        raise ValueError(advice)
-    return value
-
-
-def _si(text: str | float, expect: str, domain: Domain, example: str | None) -> float:
-    """``text`` (``'<number> <unit>'`` of dimension ``expect``) in SI, checked against ``domain``."""
-    from align.errors import AlignError
-    from align.units import DIMENSIONS, parse_quantity
-
-    what, _, default_example = DIMENSIONS[expect][1].partition(", e.g. ")
-    if isinstance(text, (int, float)):
-        value = float(text)
-    else:
-        try:
-            value = parse_quantity(text, expect)
-        except AlignError as exc:
-            raise ValueError(exc.render()) from None
-    if not domain.holds(value):
-        raise ValueError(_give(what, domain, example or default_example))
-    return value
-
-
-def quantity(expect: str, domain: Domain = ANY, example: str | None = None) -> Callable[[str], float]:
-    """A parser of ``'<number> <unit>'`` of dimension ``expect`` (a key of ``align.units.DIMENSIONS``), to SI,
-    refusing a value outside ``domain`` (the refusal shows ``example``, by default the dimension's own)."""
-
-    def parse(text: str | float) -> float:
-        return _si(text, expect, domain, example)
-
-    parse.__name__ = expect
-    return parse
-
-
-def checked_text(expect: str, domain: Domain = ANY, example: str | None = None) -> Callable[[str], str]:
-    """Like :func:`quantity`, but the command receives the text itself (stripped), once checked
-    (for options the command shows as typed, e.g. a plan's noise source)."""
-
-    def parse(text: str) -> str:
-        _si(text, expect, domain, example)
-        return str(text).strip()
-
-    parse.__name__ = expect
-    return parse
-
-
-def number(domain: Domain = ANY, example: str = "10") -> Callable[[str], float]:
-    """A parser of a plain finite number in ``domain``."""
-
-    def parse(text: str | float) -> float:
-        try:
-            value = float(text)
-        except (TypeError, ValueError):
-            raise ValueError(_give("a number", domain, example)) from None
-        if not domain.holds(value):
-            raise ValueError(_give("a number", domain, example))
-        return value
-
-    parse.__name__ = "number"
-    return parse
-
-
-def whole(low: int = 0, high: int | None = None, example: str = "100000") -> Callable[[str], int]:
-    """A parser of a whole number ``low <= n <= high`` (``'1e5'`` is read as 100000)."""
-    shown = f">= {low}" + (f" and <= {high}" if high is not None else "")
-
-    def parse(text: str | int) -> int:
-        advice = f"give a whole number {shown}, e.g. {example}"
-        if isinstance(text, int):
-            value = text
-        else:
-            try:
-                value = int(str(text).strip())
-            except ValueError:
-                try:
-                    f = float(text)
-                except ValueError:
-                    f = math.nan
-                if not (math.isfinite(f) and f.is_integer()):
-                    raise ValueError(advice) from None
-                value = int(f)
-        if value < low or (high is not None and value > high):
-            raise ValueError(advice)
-        return value
-
-    parse.__name__ = "whole"
-    return parse
-
-
 # ---- typed options: Annotated types, the default goes in the signature ----
 
 #: where the versioned JSON result goes
@@ -405,7 +275,8 @@ def UnitFlag(flag: str, help: str, optional: bool = False):
     return Annotated[str | None if optional else str, typer.Option(flag, metavar="UNIT", help=help)]
 
 
-def GyroUnits(help: str = "Unit of the gyro columns, e.g. deg/s, rad/s, mdps."):
+def GyroUnits(help: str = "Unit of the gyro columns, e.g. deg/s, rad/s, mdps, or the size of one count: "
+                          "'0.0076336 deg/s' or '131 LSB/(deg/s)'."):
     """``--gyro-units``."""
     return UnitFlag("--gyro-units", help)
 
@@ -413,3 +284,28 @@ def GyroUnits(help: str = "Unit of the gyro columns, e.g. deg/s, rad/s, mdps."):
 def Units(help: str):
     """``--units``: the generic unit option, None when not given."""
     return UnitFlag("--units", help, optional=True)
+
+
+# ---- a logger file's format: every command that reads a log takes these ----
+
+#: ``--skip-rows N``: lines at the top of a text log before its header
+SkipRows = Annotated[int, typer.Option("--skip-rows", parser=whole(0, 10_000_000, "4"), metavar="N", help=(
+    "Lines to skip at the top of a text log, before its header (a logger's preamble)."))]
+#: ``--comment CHAR``: the rest of a line after it is ignored
+Comment = Annotated[str | None, typer.Option("--comment", parser=comment, metavar="CHAR", help=(
+    "Comment character of a text log: the rest of a line after it is ignored, e.g. '#'."))]
+#: ``--delimiter C``: the field separator of a text log
+Delimiter = Annotated[str | None, typer.Option("--delimiter", parser=delimiter, metavar="C", help=(
+    "Field separator of a text log: ',' (default), ';', tab, space (any run of blanks) or another character."))]
+#: ``--time-units``: the unit of the time column, detected when left out
+TimeUnits = Annotated[str | None, typer.Option("--time-units", parser=time_units, metavar="UNIT", help=(
+    "Unit of the time column: s, ms, us or ns (default: detected from the sample interval)."))]
+
+
+def log_format(skip_rows: int = 0, comment: str | None = None, delimiter: str | None = None,
+               time_units: str | None = None):
+    """The logger file options as the library's ``align.io.formats.LogFormat`` (a comment character equal to the
+    delimiter is refused there, naming ``{comment}``)."""
+    from align.io.formats import LogFormat
+
+    return LogFormat(skip_rows, comment, delimiter, time_units)

@@ -1,270 +1,36 @@
 """Sensor logs: the one place that reads recorded data.
 
 CSV (optionally .gz, read with pyarrow), blank-separated text, .parquet, .npy and
-raw binary; columns by name; time in seconds; data converted to SI once, here.
+raw binary (columns by name: :mod:`align.io.tables`); a logger's preamble, comments,
+delimiter and the unit of its time column (:class:`~align.io.formats.LogFormat`:
+the time unit is detected from the sample interval unless given); data converted
+to SI once, here, from a unit or the size of one count (``"131 LSB/(deg/s)"``).
 Every problem becomes an :class:`~align.errors.InputError` naming the file,
-row or column; the checks of a log's rows and time stamps live here too, so
-every reader applies the same ones.
+row or column; every reader applies the same checks of a log's rows and time
+stamps (:mod:`align.io.checks`, re-exported here).
 
 Public names
 ------------
-read_columns, read_log, read_static, NpyChunks, check_finite, check_readings, check_time, check_log, MAX_READING
+read_sensor_log, SensorLog, read_log, read_static_log, StaticLog, read_static, read_columns, sensor_scale,
+NpyChunks, check_finite, check_readings, check_time, check_log, MAX_READING
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from align.errors import InputError
+from align.errors import InputError, UnitError, literal
+from align.io.checks import MAX_READING, check_finite, check_log, check_readings, check_time
 from align.io.files import existing_file
-from align.units import parse_unit
+from align.io.formats import TIME_UNITS, LogFormat, time_unit
+from align.io.tables import read_columns, shown
+from align.units import COUNT_EXAMPLES, DIMENSIONS, parse_scale, parse_unit
 
-#: the largest magnitude a reading may have in its file's unit (a 32-bit ADC's counts reach 4.3e9): beyond it a
-#: value is a corrupt sample, not a measurement (a single 1e300 would swamp every mean and deviation)
-MAX_READING = 1e12
-
-
-def _rows(n: int) -> str:
-    return "1 row" if n == 1 else f"{n} rows"
-
-
-def check_finite(x: np.ndarray, where: str, t: np.ndarray | None = None, first_row: int = 1) -> None:
-    """Reject rows of ``x`` (n, k) (or times ``t``) that are NaN or infinite, naming the first by its data row
-    (``first_row``: the number of the first row of ``x``)."""
-    bad = ~np.isfinite(x).all(axis=1)
-    if t is not None:
-        bad |= ~np.isfinite(t)
-    if bad.any():
-        rows = np.flatnonzero(bad)
-        raise InputError(f"{_rows(len(rows))} with NaN or inf (first at data row {rows[0] + first_row}); remove or "
-                         "repair them", where)
-
-
-def check_readings(x: np.ndarray, where: str, t: np.ndarray | None = None, first_row: int = 1) -> None:
-    """Reject rows of ``x`` (n, k) that are not readings: NaN or infinite (:func:`check_finite`), or with a
-    value beyond :data:`MAX_READING` in magnitude (a corrupt sample); the first is named by its data row."""
-    x = np.asarray(x)
-    x = x[:, None] if x.ndim == 1 else x
-    check_finite(x, where, t, first_row)
-    big = (np.abs(x) > MAX_READING).any(axis=1)
-    if big.any():
-        rows = np.flatnonzero(big)
-        value = float(x[rows[0]][np.abs(x[rows[0]]) > MAX_READING][0])
-        raise InputError(f"{_rows(len(rows))} with a value beyond +/-{MAX_READING:.0e} (first at data row "
-                         f"{rows[0] + first_row}: {value:.3g}): not a sensor reading; remove or repair them", where)
-
-
-def check_time(t: np.ndarray, where: str, gap: float | None = None, jitter: bool = False) -> None:
-    """Time must increase; with ``gap``, no step may exceed ``gap`` times the median step
-    (and, with ``jitter``, none may fall below ``2 - gap`` times it: uniform sampling)."""
-    dt = np.diff(t)
-    if np.any(dt <= 0):
-        k = int(np.argmax(dt <= 0))
-        raise InputError(f"time does not increase at data row {k + 2} (t={t[k + 1]:.9g} s after {t[k]:.9g} s); "
-                         "sort the log or fix the time column", where)
-    if gap is None or len(dt) == 0:
-        return
-    med = float(np.median(dt))
-    off = (dt > gap * med) | ((dt < (2 - gap) * med) if jitter else False)
-    if off.any():
-        k = int(np.argmax(off))
-        raise InputError(f"{int(off.sum())} time gaps{' or jitter' if jitter else ''} beyond {100 * (gap - 1):g} % of the "
-                         f"{med:.4g} s median step: gap in the time series at t={t[k]:.6g} s (step {dt[k]:.4g} s); "
-                         "resample or split the file", where)
-
-
-def check_log(t: np.ndarray, g: np.ndarray, where: str, min_rows: int = 10) -> None:
-    """Reject NaN or infinite rows, non-increasing time and logs that are too short."""
-    if len(t) < min_rows:
-        raise InputError(f"only {len(t)} rows; at least {min_rows} are needed", where)
-    check_readings(g, where, t)
-    check_time(t, where)
-
-
-def read_columns(path: str | Path, names: list[str] | None = None,
-                 time_column: str | None = None) -> tuple[list[str], np.ndarray]:
-    """Read named numeric columns of a CSV (.csv, .csv.gz), .parquet or .npy file.
-
-    Parameters
-    ----------
-    path : str or Path
-    names : list of str, optional
-        Columns to read (all when None). For .npy files (no names) the columns
-        are taken in order and named ``col0, col1, ...`` unless ``names``
-        matches the array's width.
-    time_column : str, optional
-        The name among ``names`` that is the time (a missing one then points to the sample rate).
-
-    Returns
-    -------
-    names : list of str
-    data : ndarray, shape (n, k), float64
-    """
-    p = existing_file(path)
-    suffixes = "".join(p.suffixes[-2:]).lower()
-    if p.suffix.lower() == ".npy":
-        try:
-            arr = np.load(p, mmap_mode="r")
-        except (ValueError, OSError, EOFError) as exc:
-            raise InputError(f"cannot read .npy ({_first_line(exc)})", str(path)) from None
-        if not isinstance(arr, np.ndarray) or arr.dtype.kind not in "fiu":
-            kind = getattr(arr, "dtype", type(arr).__name__)
-            raise InputError(f"holds {kind} values; expected numbers (an integer or float array)", str(path))
-        arr = np.asarray(arr, dtype=float)
-        if arr.ndim == 1:
-            arr = arr[:, None]
-        if arr.ndim != 2 or arr.shape[0] == 0:
-            raise InputError(f"expected an n x k array of at least one row, got shape {tuple(arr.shape)}", str(path))
-        if names is not None and len(names) != arr.shape[1]:
-            raise InputError(f"has {arr.shape[1]} columns, expected {len(names)} ({', '.join(map(_shown, names))})",
-                             str(path))
-        return (list(names) if names is not None else [f"col{i}" for i in range(arr.shape[1])]), arr
-    if p.suffix.lower() == ".parquet":
-        import pyarrow as pa
-        import pyarrow.parquet as pq
-
-        try:
-            _require(names, pq.read_schema(p).names, path, time_column)
-            table = _as_float(pq.read_table(p, columns=names), path)
-        except InputError:
-            raise
-        except Exception as exc:  # pyarrow raises several types for a bad or damaged file
-            raise InputError(f"cannot read parquet ({_first_line(exc)})", str(path)) from None
-    elif _is_whitespace_table(p):
-        return _whitespace_columns(p, names)
-    elif suffixes.endswith((".csv", ".csv.gz", ".txt", ".txt.gz")) or p.suffix.lower() in (".csv", ".gz"):
-        import pyarrow as pa
-        import pyarrow.csv as pcsv
-
-        with open(p, "rb") as fh:
-            if fh.read(2) in (b"\xff\xfe", b"\xfe\xff"):
-                raise InputError("is UTF-16 text; save it as UTF-8", str(path))
-        try:
-            with pcsv.open_csv(p) as reader:
-                header = reader.schema.names
-        except UnicodeDecodeError:
-            raise InputError("its header is not UTF-8 text; save the file as UTF-8", str(path)) from None
-        except (pa.ArrowException, OSError, ValueError) as exc:
-            raise InputError(f"cannot read CSV ({_first_line(exc)})", str(path)) from None
-        _require(names, header, path, time_column)
-        wanted = names or header
-        opts = pcsv.ConvertOptions(include_columns=wanted, column_types={n: pa.float64() for n in wanted})
-        try:
-            table = pcsv.read_csv(p, convert_options=opts)
-        except (pa.ArrowException, OSError, ValueError) as exc:
-            raise InputError(f"a value is not a number ({_first_line(exc)}); clean the file", str(path)) from None
-    else:
-        raise InputError("unknown file type; use .csv, .csv.gz, .npy or .parquet", str(path))
-    cols = names or table.column_names
-    if table.num_rows == 0:
-        raise InputError("has no data rows (a header alone); record data into it", str(path))
-    data = np.empty((len(cols), table.num_rows))  # filled row by row, returned transposed
-    for j, name in enumerate(cols):
-        pos = 0
-        for chunk in table.column(name).chunks:
-            data[j, pos : pos + len(chunk)] = _float_chunk(chunk)
-            pos += len(chunk)
-    return list(cols), data.T
-
-
-def _float_chunk(chunk) -> np.ndarray:
-    """A float64 Arrow array as numpy, empty cells as NaN.
-
-    Reads the buffers directly: ``Array.to_numpy`` imports pandas on first use,
-    which alone costs more than reading a million-row CSV.
-    """
-    validity, values = chunk.buffers()[:2]
-    arr = np.frombuffer(values, dtype=np.float64, count=len(chunk) + chunk.offset)[chunk.offset :]
-    if chunk.null_count:
-        bits = np.unpackbits(np.frombuffer(validity, dtype=np.uint8), bitorder="little")
-        arr = np.where(bits[chunk.offset : chunk.offset + len(chunk)].astype(bool), arr, np.nan)
-    return arr
-
-
-def _is_whitespace_table(p: Path) -> bool:
-    """A header-less text table of numbers separated by blanks (imu_tk's .mat text, ``x y z`` files)."""
-    if p.suffix.lower() in (".npy", ".parquet", ".gz"):
-        return False
-    with open(p, "rb") as fh:
-        first = fh.readline(4096).decode("ascii", "replace").strip()
-    if not first or "," in first or ";" in first:
-        return False
-    try:
-        [float(v) for v in first.split()]
-    except ValueError:
-        return False
-    return True
-
-
-def _whitespace_columns(p: Path, names: list[str] | None) -> tuple[list[str], np.ndarray]:
-    """Columns ``col0, col1, ...`` of a blank-separated numeric table (parsed in C by numpy)."""
-    try:
-        text = p.read_bytes().decode("ascii")
-    except UnicodeDecodeError as exc:
-        line = p.read_bytes()[: exc.start].count(b"\n") + 1
-        raise InputError(f"line {line}: byte 0x{exc.object[exc.start]:02x} is not part of a number; a blank-separated "
-                         "table holds only numbers: clean the file", str(p)) from None
-    width = len(text.split("\n", 1)[0].split())
-    try:
-        values = np.array(text.split(), dtype=float)
-    except ValueError:
-        for row, line in enumerate(text.splitlines(), 1):
-            try:
-                [float(w) for w in line.split()]
-            except ValueError as exc:  # "could not convert string to float: 'five'"
-                word = str(exc).split(": ", 1)[-1]
-                raise InputError(f"line {row}: {_shown(word)} is not a number; clean the file", str(p)) from None
-        raise
-    if values.size % width:
-        raise InputError(f"rows of unequal length (first row has {width} numbers)", str(p))
-    data = values.reshape(-1, width)
-    available = [f"col{i}" for i in range(width)]
-    _require(names, available, p)
-    idx = [available.index(n) for n in (names or available)]
-    return [available[i] for i in idx], data[:, idx]
-
-
-def _shown(text: str, limit: int = 40) -> str:
-    """User text for a message: shortened, its braces made harmless (never read as a placeholder)."""
-    text = text if len(text) <= limit else text[: limit - 3] + "..."
-    return text.replace("{", "(").replace("}", ")")
-
-
-def _first_line(exc: Exception) -> str:
-    lines = str(exc).strip().splitlines()
-    return _shown(lines[0] if lines else type(exc).__name__, 200)
-
-
-def _as_float(table, path):
-    """Every column of an Arrow table as float64; a column that is not numeric is named."""
-    import pyarrow as pa
-
-    for name, column in zip(table.column_names, table.columns):
-        kind = column.type
-        if not (pa.types.is_floating(kind) or pa.types.is_integer(kind) or pa.types.is_decimal(kind)
-                or pa.types.is_null(kind)):
-            raise InputError(f"column '{_shown(name)}' holds {kind} values, not numbers; give numeric columns "
-                             "(name them with {columns})", str(path))
-    try:
-        return table.cast(pa.schema([(n, pa.float64()) for n in table.column_names]))
-    except (pa.ArrowInvalid, pa.ArrowNotImplementedError) as exc:
-        raise InputError(f"a value is not a number ({_first_line(exc)}); clean the file", str(path)) from None
-
-
-def _require(names: list[str] | None, available: list[str], path, time_column: str | None = None) -> None:
-    """Every name in ``names`` must be a column; a missing time column points to the sample rate."""
-    if names is None:
-        return
-    missing = [n for n in names if n not in available]
-    if missing:
-        advice = "name the columns with {columns}"
-        if missing == [time_column]:
-            advice = "give {rate_hz} for a log without time, or " + advice
-        listed = ", ".join(_shown(a) for a in available) or "none"
-        raise InputError(f"no column {', '.join(repr(_shown(m)) for m in missing)} (columns: {listed}); " + advice,
-                         str(path))
+__all__ = ["read_sensor_log", "SensorLog", "read_log", "read_static_log", "StaticLog", "read_static", "read_columns",
+           "sensor_scale", "NpyChunks", "check_finite", "check_readings", "check_time", "check_log", "MAX_READING"]
 
 
 def _check_rate(rate_hz: float | None, path, missing: str = "no time column: give {rate_hz}") -> None:
@@ -276,15 +42,117 @@ def _check_rate(rate_hz: float | None, path, missing: str = "no time column: giv
                          "{rate_hz=100}", str(path))
 
 
-def read_log(
+def sensor_scale(units: str, expect: str | None, field: str = "units", counts: bool = False) -> tuple[float, str]:
+    """The factor that takes a log's numbers to SI, and the unit its readings are shown in.
+
+    Parameters
+    ----------
+    units : str
+        A unit of ``expect`` (``"deg/s"``), the size of one count (``"0.0076336 deg/s"``) or a
+        datasheet sensitivity (``"131 LSB/(deg/s)"``), or ``"counts"`` (see :func:`align.units.parse_scale`).
+    expect : str or None
+        A key of :data:`align.units.DIMENSIONS` (``"angular_rate"``, ``"acceleration"``,
+        ``"magnetic_field"``, ``"counts"``); None: any unit.
+    field : str
+        The input that gave ``units``, for messages (``{gyro_units}``).
+    counts : bool
+        Whether readings may stay in raw counts; when not, ``"counts"`` is refused with the advice
+        to give the size of one count.
+
+    Returns
+    -------
+    factor : float
+        Multiplies a number of the log into SI (or counts).
+    shown : str
+        The unit results show the readings in: ``units`` itself, or for a count size the dimension's
+        unit (``deg/s``, ``m/s^2``, ``uT``).
+    """
+    where = "{" + field + "}"
+    if expect is None or expect == "counts" or expect not in COUNT_EXAMPLES:
+        return parse_unit(units, expect, where).factor, units
+    factor, unit = parse_scale(units, expect, where)
+    if not counts and parse_unit(unit).dim == DIMENSIONS["counts"][0].dim:
+        size, sensitivity, part = COUNT_EXAMPLES[expect]
+        what = DIMENSIONS[expect][1].split(",")[0]
+        why = " (a gyro's M = g/w is dimensionless only then)" if expect == "angular_rate" else ""
+        raise UnitError(f"'{literal(units)}' leaves the readings in raw counts, but they are needed as {what} here{why}; "
+                        f"give the size of one count, e.g. {{{field}={size}}} or {{{field}={sensitivity}}} for {part}",
+                        where)
+    return factor, unit
+
+
+@dataclass(frozen=True, eq=False)
+class SensorLog:
+    """A sensor log as read: time in s, readings in SI, and how the file was read.
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,)
+        Time, s (from the time column in ``time_units``, or ``arange(n) / rate_hz``).
+    data : ndarray, shape (n, k)
+        Readings in SI (or counts, when read in counts).
+    units : str
+        The unit the readings were given in, as typed (``"131 LSB/(deg/s)"``).
+    shown : str
+        The unit results show them in (``"deg/s"`` for that count size).
+    time_units : str or None
+        Unit of the time column (a key of :data:`~align.io.formats.TIME_UNITS`); None: no time column.
+    time_detected : bool
+        True when ``time_units`` was detected from the sample interval, False when given.
+    rate_hz : float
+        The sample rate: the median one of the time column, or the one given, Hz.
+    format : LogFormat
+        The preamble, comments and delimiter the file was read with.
+    """
+
+    t: np.ndarray
+    data: np.ndarray
+    units: str
+    shown: str
+    time_units: str | None
+    time_detected: bool
+    rate_hz: float
+    format: LogFormat = field(default_factory=LogFormat)
+
+    def inputs(self) -> dict:
+        """How the file was read, for a result's ``inputs``: the format options and the time unit
+        (``time_units``, with ``time_units_detected``)."""
+        return {**self.format.to_dict(), "time_units": self.time_units, "time_units_detected": self.time_detected}
+
+    def time_note(self) -> str | None:
+        """One sentence on the time column's unit when it is not seconds (None otherwise): results state it."""
+        if self.time_units in (None, "s"):
+            return None
+        how = "detected from the median step" if self.time_detected else "as given"
+        return f"time column read in {self.time_units} ({how}: {self.rate_hz:.6g} Hz)"
+
+
+def _time_of(raw: np.ndarray, column: str, where: str, fmt: LogFormat) -> tuple[np.ndarray, str, bool]:
+    """Time in s from a time column's numbers; its unit detected or given (:func:`~align.io.formats.time_unit`)."""
+    step = float(np.median(np.diff(raw))) if len(raw) > 1 else float("nan")
+    unit, detected = time_unit(step, column, where, fmt.time_units)
+    return (raw * TIME_UNITS[unit] if unit != "s" else raw), unit, detected
+
+
+def _rate_only(fmt: LogFormat, path) -> None:
+    """A time unit goes with a time column: refused for a log read at a given sample rate."""
+    if fmt.time_units is not None:
+        raise InputError("{time_units} applies to a time column, and this log is read without one ({rate_hz}); "
+                         "leave one of them out", str(path))
+
+
+def read_sensor_log(
     path: str | Path,
     columns: list[str],
     units: str,
     time_column: str | None = "time",
     rate_hz: float | None = None,
-    expect: str = "angular_rate",
-) -> tuple[np.ndarray, np.ndarray]:
-    """Read a sensor log: time (s) and data columns converted to SI.
+    expect: str | None = "angular_rate",
+    log_format: LogFormat | None = None,
+    counts: bool = False,
+    field: str | None = None,
+) -> SensorLog:
+    """Read a sensor log: time (s) and data columns converted to SI, and how the file was read.
 
     Parameters
     ----------
@@ -292,36 +160,74 @@ def read_log(
     columns : list of str
         The data columns, e.g. ``["gyro_x", "gyro_y", "gyro_z"]``.
     units : str
-        Unit of the data columns, e.g. ``"deg/s"``; checked against ``expect``.
+        Unit of the data columns, e.g. ``"deg/s"``, or the size of one count (``"0.0076336 deg/s"``,
+        ``"131 LSB/(deg/s)"``); checked against ``expect`` (see :func:`sensor_scale`).
     time_column : str or None
-        Name of the time column (seconds); None when ``rate_hz`` is given.
+        Name of the time column; None when ``rate_hz`` is given.
     rate_hz : float, optional
-        Sample rate for logs without a time column.
+        Sample rate for logs without a time column (the time column, if any, is then not read).
+    expect : str or None
+        Dimension of the readings (a key of :data:`align.units.DIMENSIONS`); None: any unit.
+    log_format : LogFormat, optional
+        Preamble, comments, delimiter and the unit of the time column (detected when not given).
+    counts : bool
+        Whether the readings may stay in raw counts (``units="counts"``).
+    field : str, optional
+        The input that gave ``units``, for messages; default ``gyro_units`` for an angular rate,
+        ``units`` otherwise.
+
+    Returns
+    -------
+    SensorLog
+        ``t`` (n,) s, ``data`` (n, len(columns)) SI, the time unit used and whether it was detected.
+    """
+    fmt = log_format or LogFormat()
+    field = field or ("gyro_units" if expect == "angular_rate" else "units")
+    factor, unit_shown = sensor_scale(units, expect, field, counts)
+    use_time = time_column is not None and rate_hz is None
+    wanted = ([time_column] if use_time else []) + list(columns)
+    p = Path(path)
+    if p.suffix.lower() == ".npy":
+        _, data = read_columns(p, log_format=fmt)
+        if data.shape[1] != len(wanted):
+            raise InputError(f"has {data.shape[1]} columns; expected {len(wanted)} ({', '.join(map(shown, wanted))})"
+                             + ("; give {rate_hz} for a file without time" if use_time else ""), str(path))
+    else:
+        _, data = read_columns(p, wanted, time_column if use_time else None, fmt)
+    if use_time:
+        raw_t, values = data[:, 0], data[:, 1:]
+        check_readings(values, str(path), raw_t)
+        t, tu, detected = _time_of(raw_t, time_column, str(path), fmt)
+        step = float(np.median(np.diff(t))) if len(t) > 1 else float("nan")
+        fs = 1.0 / step if step > 0 else float("nan")
+    else:
+        _check_rate(rate_hz, path)
+        _rate_only(fmt, path)
+        t, values, tu, detected, fs = np.arange(len(data)) / rate_hz, data, None, False, float(rate_hz)
+        check_readings(values, str(path), t)
+    return SensorLog(np.ascontiguousarray(t), values * factor, units, unit_shown, tu, detected, fs, fmt)
+
+
+def read_log(
+    path: str | Path,
+    columns: list[str],
+    units: str,
+    time_column: str | None = "time",
+    rate_hz: float | None = None,
+    expect: str | None = "angular_rate",
+    log_format: LogFormat | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Read a sensor log: time (s) and data columns converted to SI (:func:`read_sensor_log`, which also
+    tells how the file was read).
 
     Returns
     -------
     t : ndarray, shape (n,)
     data : ndarray, shape (n, len(columns)), SI
     """
-    factor = parse_unit(units, expect, "{units}" if expect != "angular_rate" else "{gyro_units}").factor
-    use_time = time_column is not None and rate_hz is None
-    wanted = ([time_column] if use_time else []) + list(columns)
-    p = Path(path)
-    if p.suffix.lower() == ".npy":
-        _, arr = read_columns(p)
-        if arr.shape[1] != len(wanted):
-            raise InputError(f"has {arr.shape[1]} columns; expected {len(wanted)} ({', '.join(map(_shown, wanted))})"
-                             + ("; give {rate_hz} for a file without time" if use_time else ""), str(path))
-        data = arr
-    else:
-        _, data = read_columns(p, wanted, time_column if use_time else None)
-    if use_time:
-        t, values = data[:, 0], data[:, 1:]
-    else:
-        _check_rate(rate_hz, path)
-        t, values = np.arange(len(data)) / rate_hz, data
-    check_readings(values, str(path), t)
-    return np.ascontiguousarray(t), values * factor
+    log = read_sensor_log(path, columns, units, time_column, rate_hz, expect, log_format,
+                          counts=expect == "counts")
+    return log.t, log.data
 
 
 class NpyChunks:
@@ -334,10 +240,13 @@ class NpyChunks:
     ----------
     shape : tuple
         ``(n, C)`` of the stored array.
+    scale : float
+        Multiplies every value read (the size of one count; 1: the numbers as stored).
     """
 
-    def __init__(self, path: str | Path, channels: int | None = None) -> None:
+    def __init__(self, path: str | Path, channels: int | None = None, scale: float = 1.0) -> None:
         p = existing_file(path)
+        self.scale = scale
         if p.suffix.lower() in (".bin", ".f8", ".f4", ".raw"):
             dtype = np.dtype("<f4" if p.suffix.lower() == ".f4" else "<f8")
             if not channels:
@@ -382,37 +291,74 @@ class NpyChunks:
                     if columns is not None:
                         block = block[:, cols]
                     block = block.astype(np.float64, copy=False)
-                yield block
+                yield block * self.scale if self.scale != 1 else block
 
 
-def read_static(log: str | Path, names: list[str], rate_hz: float | None):
+@dataclass(frozen=True, eq=False)
+class StaticLog:
+    """A static record for the Allan deviation, as read.
+
+    Attributes
+    ----------
+    data : ndarray, shape (n, C), or NpyChunks
+        The raw numbers times ``scale`` (no SI conversion: deviations are scaled afterwards).
+    rate_hz : float
+        Sample rate, Hz.
+    time_units : str or None
+        Unit of the time column (None: no time column, ``rate_hz`` given).
+    time_detected : bool
+        True when ``time_units`` was detected from the sample interval.
+    """
+
+    data: object
+    rate_hz: float
+    time_units: str | None
+    time_detected: bool
+
+
+def read_static_log(log: str | Path, names: list[str], rate_hz: float | None, log_format: LogFormat | None = None,
+                    scale: float = 1.0) -> StaticLog:
     """Raw columns of a static log and its sample rate, for the Allan deviation.
 
     No unit conversion (the deviations are scaled afterwards, so no SI copy of a
-    large record is made). ``.npy`` and raw binary files come back as a
-    :class:`NpyChunks` source read in chunks; CSV needs a uniform time column
-    (gaps are refused with their position) unless ``rate_hz`` is given.
+    large record is made) but for ``scale``, the size of one count in the unit the
+    deviations are shown in (1 for readings in a unit). ``.npy`` and raw binary files
+    come back as a :class:`NpyChunks` source read in chunks; text needs a uniform time
+    column ``time`` (gaps are refused with their position; its unit detected or given by
+    ``log_format``) unless ``rate_hz`` is given.
     """
     log = Path(log)
+    fmt = log_format or LogFormat()
     if log.suffix.lower() in (".npy", ".bin", ".f8", ".f4", ".raw"):
         _check_rate(rate_hz, log, f"a {log.suffix} file has no time: give {{rate_hz}}")
-        source = NpyChunks(log, len(names))
+        if fmt.given():
+            raise InputError(f"{', '.join('{' + k + '}' for k in fmt.given())} apply to text logs, not to a "
+                             f"{log.suffix} file; leave them out", str(log))
+        _rate_only(fmt, log)
+        source = NpyChunks(log, len(names), scale)
         if source.shape[1] != len(names):
             raise InputError(f"has {source.shape[1]} columns but {len(names)} names were given; name each column with "
                              "{columns}", str(log))
         if source.shape[0] == 0:
             raise InputError("holds no samples", str(log))
-        return source, float(rate_hz)  # its samples are checked as they are read (align.noise.allan)
+        return StaticLog(source, float(rate_hz), None, False)  # its samples are checked as read (align.noise.allan)
     if rate_hz is not None:
         _check_rate(rate_hz, log)
+        _rate_only(fmt, log)
     wanted = names if rate_hz is not None else ["time"] + names
-    _, data = read_columns(log, wanted, None if rate_hz is not None else "time")
+    _, data = read_columns(log, wanted, None if rate_hz is not None else "time", fmt)
     if rate_hz is not None:
         check_readings(data, str(log))
-        return data, float(rate_hz)
-    t = data[:, 0]
+        return StaticLog(data * scale if scale != 1 else data, float(rate_hz), None, False)
+    check_readings(data[:, 1:], str(log), data[:, 0])
+    t, unit, detected = _time_of(data[:, 0], "time", str(log), fmt)
     check_log(t, data[:, 1:], str(log), min_rows=3)
     check_time(t, str(log), gap=1.5, jitter=True)  # an Allan deviation needs uniform samples
-    return np.ascontiguousarray(data[:, 1:]), 1.0 / float(np.median(np.diff(t)))
+    values = np.ascontiguousarray(data[:, 1:])
+    return StaticLog(values * scale if scale != 1 else values, 1.0 / float(np.median(np.diff(t))), unit, detected)
 
 
+def read_static(log: str | Path, names: list[str], rate_hz: float | None, log_format: LogFormat | None = None):
+    """Raw columns of a static log and its sample rate (:func:`read_static_log`): ``(data, rate_hz)``."""
+    got = read_static_log(log, names, rate_hz, log_format)
+    return got.data, got.rate_hz

@@ -293,17 +293,22 @@ def run_allan(runs: list, fs: float, names: list[str], units: str, grid="dense",
     return AllanJob(res, fits, figures, rep, units, len(runs))
 
 
-def read_runs(paths: list, columns: list[str], rate_hz: float | None = None) -> tuple[list, float]:
+def read_runs(paths: list, columns: list[str], rate_hz: float | None = None, log_format=None,
+              scale: float = 1.0) -> tuple[list, float]:
     """Read static recordings of one sensor for :func:`run_allan`, at one common sample rate.
 
     Parameters
     ----------
     paths : list of str or Path
-        ``.csv``, ``.csv.gz``, ``.npy`` or raw float64 ``.bin`` files (see :func:`align.io.read_static`).
+        ``.csv``, ``.csv.gz``, ``.npy`` or raw float64 ``.bin`` files (see :func:`align.io.read_static_log`).
     columns : list of str
         Data columns, C of them.
     rate_hz : float, optional
         Sample rate of files without a time column, Hz.
+    log_format : align.io.LogFormat, optional
+        Preamble, comments, delimiter of text files and the unit of their time column (detected when not given).
+    scale : float
+        The size of one count in the unit given to :func:`run_allan` (1: the files hold that unit).
 
     Returns
     -------
@@ -316,14 +321,15 @@ def read_runs(paths: list, columns: list[str], rate_hz: float | None = None) -> 
     InputError
         A run whose sample rate differs from the first run's (named by its file).
     """
-    from align.io import read_static
+    from align.io import read_static_log
 
     runs, fs = [], None
     for path in paths:
-        data, f = read_static(path, columns, rate_hz)
+        got = read_static_log(path, columns, rate_hz, log_format, scale)
+        f = got.rate_hz
         if fs is not None and abs(f - fs) > 1e-9 * fs:
             raise InputError(f"sample rate {f:g} Hz differs from the first run's {fs:g} Hz", str(path))
-        runs.append(data)
+        runs.append(got.data)
         fs = f
     if fs is None:
         raise InputError("no recording given", "{paths}")

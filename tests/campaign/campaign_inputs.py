@@ -241,6 +241,7 @@ def build_inputs(d: Path) -> dict[str, Path]:
     _mount_and_manoeuvres(d)
     _results(d)
     _misc(d)
+    _logger_files(d)
     return {p.name: p for p in d.iterdir() if p.is_file()}
 
 
@@ -320,13 +321,30 @@ def _flip(read: tuple[list[str], np.ndarray], name: str):
     return names, data
 
 
+def _in_test(plan: str, line: str) -> str:
+    """``plan`` with ``line`` (``key = value``) in its ``[test]`` table, replacing the key's line there (a plan
+    written by ``simulate`` has a ``[test]`` table already; TOML refuses a table or a key given twice)."""
+    lines, key = plan.splitlines(), line.split("=")[0].strip()
+    if "[test]" not in lines:
+        return f"[test]\n{line}\n\n" + plan
+    i = lines.index("[test]")
+    j = i + 1
+    while j < len(lines) and not lines[j].startswith("["):
+        if lines[j].split("=")[0].strip() == key:
+            del lines[j]
+        else:
+            j += 1
+    lines.insert(i + 1, line)
+    return "\n".join(lines) + "\n"
+
+
 def _plan_variants(d: Path) -> None:
     plan = (d / "plan.toml").read_text()
     w = lambda name, text: (d / name).write_text(text)  # noqa: E731
-    w("plan_latitud.toml", '[test]\nlatitud = "48.1 deg"\n\n' + plan)
-    w("plan_latitude.toml", '[test]\nlatitude = "48.1 deg"\n\n' + plan)
+    w("plan_latitud.toml", _in_test(plan, 'latitud = "48.1 deg"'))
+    w("plan_latitude.toml", _in_test(plan, 'latitude = "48.1 deg"'))
     w("plan_tset.toml", '[tset]\nlatitude = "48.1 deg"\n\n' + plan)
-    w("plan_rateacc.toml", '[test]\nrate_acuracy = "0.01 %"\n\n' + plan)
+    w("plan_rateacc.toml", _in_test(plan, 'rate_acuracy = "0.01 %"'))
     w("plan_rat.toml", _toml_lines(plan, 'rate = "100', 'rat = "100'))
     w("plan_axes.toml", _toml_lines(plan, 'axis = "+x"', 'axes = "+x"\naxis = "+x"'))
     w("plan_stepp.toml", plan.replace("[[step]]", "[[stepp]]"))
@@ -339,9 +357,9 @@ def _plan_variants(d: Path) -> None:
     w("plan_huge.toml", _toml_lines(plan, 'rate = "100 deg/s"', 'rate = "1e300 deg/s"'))
     w("plan_zero.toml", _toml_lines(plan, 'rate = "100 deg/s"', 'rate = "0 deg/s"'))
     w("plan_both.toml", _toml_lines(plan, 'rate = "100 deg/s"', 'rate = "100 deg/s"\nangle = "360 deg"'))
-    w("plan_lat100.toml", '[test]\nlatitude = "100 deg"\n\n' + plan)
-    w("plan_latbare.toml", '[test]\nlatitude = "48"\n\n' + plan)
-    w("plan_negacc.toml", '[test]\nangle_accuracy = "-1 deg"\n\n' + plan)
+    w("plan_lat100.toml", _in_test(plan, 'latitude = "100 deg"'))
+    w("plan_latbare.toml", _in_test(plan, 'latitude = "48"'))
+    w("plan_negacc.toml", _in_test(plan, 'angle_accuracy = "-1 deg"'))
     w("plan_empty.toml", "")
     w("plan_comment.toml", "# only a comment\n")
     w("plan_syntax.toml", plan + "\n[[step]\naxis = +y\n")
@@ -582,6 +600,38 @@ def _mag_inputs(d: Path, rng: np.random.Generator) -> None:
     bazhin = SHARED_DATA / "magnetometer" / "bazhin" / "mag_out.txt"
     if bazhin.is_file() and bazhin.stat().st_size < 100_000:
         shutil.copy(bazhin, d / "bazhin_mag_out.txt")
+
+
+def _logger_files(d: Path) -> None:
+    """Logs as data loggers write them (issue 12): time in ms or ns, a preamble, comments, ';', tabs, blanks,
+    raw counts; each must read like the plain file with the options that say so."""
+    names, data = read_csv(d / "session.csv")
+    text = (d / "session.csv").read_text()
+    ms, ns = data.copy(), data.copy()
+    ms[:, 0] *= 1e3
+    ns[:, 0] = np.round(ns[:, 0] * 1e9)
+    write_csv(d / "session_ms.csv", names, ms)
+    (d / "session_ns.csv").write_text(_csv_text(names, ns, "%.17g"))
+    (d / "session_preamble.csv").write_text("Fs,50\nLogging Type,1\nsensor,sim\n" + text)
+    lines = text.splitlines()
+    lines = ["# logger 1.0", "# gyro in deg/s", lines[0], *lines[1:400], "# paused", *lines[400:]]
+    (d / "session_comments.csv").write_text("\n".join(lines) + "\n")
+    (d / "session_tab.csv").write_text(text.replace(",", "\t"))
+    (d / "session_blanks.txt").write_text(text.replace(",", "   "))
+    counts = np.column_stack([data[:, 0], np.round(data[:, 1:] * 131)])
+    write_csv(d / "session_counts.csv", names, counts)
+    names_s, static = read_csv(d / "static.csv")
+    (d / "static_preamble.csv").write_text("Fs,100\nLogging Type,1\nInitialization time,-1\nWaiting time,-1\n"
+                                           + (d / "static.csv").read_text())
+    static_ms = static.copy()
+    static_ms[:, 0] *= 1e3
+    write_csv(d / "static_ms.csv", names_s, static_ms)
+    names_a, accel = read_csv(d / "accel.csv")
+    accel_us = accel.copy()
+    accel_us[:, 0] = np.round(accel_us[:, 0] * 1e6)
+    write_csv(d / "accel_us.csv", names_a, accel_us)
+    (d / "mag_semicolon.csv").write_text("# HMC5883L capture\n" + (d / "mag.csv").read_text().replace(",", ";"))
+    (d / "ferraris_preamble.csv").write_text("logger,2\nrate,50\n" + (d / "ferraris.csv").read_text())
 
 
 def _mount_and_manoeuvres(d: Path) -> None:

@@ -1,0 +1,366 @@
+"""Logger files as they come: a preamble, comment lines, a delimiter, the unit of the time column.
+
+A data logger rarely writes a plain CSV in seconds: the MPU-6050 logs of ``../shared/data`` start
+with four metadata lines (``Fs,100``) before their header, others write ``#`` comments, ``;`` or
+tab separated fields, or time in milliseconds, microseconds or nanoseconds. :class:`LogFormat`
+says how to read such a file; every log reader (:mod:`align.io.logs`) takes one, and without one
+reads a plain CSV by its fastest path, unchanged.
+
+The time column's unit is detected from the median sample interval unless given
+(:func:`time_unit`): a MEMS IMU samples between about 1 Hz and 100 kHz, and typically between
+10 Hz and 10 kHz, so the unit is the one of s, ms, us, ns that puts the median step's rate in
+10 Hz - 10 kHz (seconds up to 100 kHz, nanoseconds down to 1 Hz):
+
+=========================  ======
+median step (file units)   unit
+=========================  ======
+1e-5 to 0.1                s
+0.1 to 100                 ms
+100 to 1e5                 us
+1e5 to 1e9                 ns
+=========================  ======
+
+A step outside these, or a given unit that puts the rate outside 1 Hz - 100 kHz, is refused naming
+the time column and the fix. The one ambiguity left is inherent: a 1-10 Hz log in seconds reads
+like a 1-10 kHz log in milliseconds (give the unit then); the detected unit is stated with the result.
+
+Public names
+------------
+LogFormat, TIME_UNITS, DELIMITERS, RATE_BAND_HZ, delimiter_char, time_unit, csv_source, preamble_hint,
+content_lines
+"""
+
+from __future__ import annotations
+
+import gzip
+import math
+import zlib
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+from align.errors import InputError, literal
+
+#: time unit -> its size in seconds
+TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
+#: the sample rates an IMU log may have, Hz (outside: not a sample interval, or the wrong time unit)
+RATE_BAND_HZ = (1.0, 1e5)
+#: the median step (in the file's numbers) up to which each unit is detected (see the module's table)
+_DETECT = (("s", 1e-5, 0.1), ("ms", 0.1, 100.0), ("us", 100.0, 1e5), ("ns", 1e5, 1e9))
+#: names of delimiters that are awkward to type
+DELIMITERS = {"tab": "\t", "\\t": "\t", "space": " ", "comma": ",", "semicolon": ";", "pipe": "|"}
+#: characters that can be neither a delimiter nor a comment: they are parts of numbers, quotes or line ends
+_NUMERIC = set("0123456789.+-eE\"\r\n")
+
+
+def delimiter_char(text: str) -> str:
+    """A delimiter as typed (``','``, ``';'``, ``'tab'``, ``'\\t'``, ``'space'``, ``'|'``) -> the one character.
+
+    Raises
+    ------
+    InputError
+        Anything else (named as ``{delimiter}``).
+    """
+    char = DELIMITERS.get(str(text).strip().lower(), text if len(str(text)) == 1 else None)
+    if char is None or char in _NUMERIC or char.isalnum():
+        raise InputError(f"{literal(repr(text))} is not a delimiter; give one character such as ',' or ';', or tab or "
+                         "space", "{delimiter}")
+    return char
+
+
+@dataclass(frozen=True)
+class LogFormat:
+    """How to read a logger's text file; the default is a plain CSV with time in detected units.
+
+    Attributes
+    ----------
+    skip_rows : int
+        Lines at the top of the file to skip before the header (a logger's preamble), >= 0.
+    comment : str or None
+        One character: from it to the end of the line is ignored (lines that hold nothing else are
+        dropped), e.g. ``'#'``.
+    delimiter : str or None
+        The field separator: one character, or ``'tab'``, ``'space'`` (any run of blanks), ``';'``...
+        (:func:`delimiter_char`); None: ``','``.
+    time_units : str or None
+        Unit of the time column, one of :data:`TIME_UNITS`; None: detected from the median step
+        (:func:`time_unit`).
+    """
+
+    skip_rows: int = 0
+    comment: str | None = None
+    delimiter: str | None = None
+    time_units: str | None = None
+
+    def __post_init__(self) -> None:
+        if isinstance(self.skip_rows, bool) or not isinstance(self.skip_rows, int) or self.skip_rows < 0:
+            raise InputError(f"{literal(repr(self.skip_rows))} is not a number of lines; give a whole number >= 0, "
+                             "e.g. {skip_rows=4}", "{skip_rows}")
+        if self.delimiter is not None:
+            object.__setattr__(self, "delimiter", delimiter_char(self.delimiter))
+        c = self.comment
+        if c is not None and (not isinstance(c, str) or len(c) != 1 or c in _NUMERIC or c.isalnum() or c.isspace()
+                              or c == self.separator):
+            raise InputError(f"{literal(repr(c))} is not a comment character; give one character that starts a "
+                             "comment and is not the delimiter, e.g. {comment=#}", "{comment}")
+        if self.time_units is not None and self.time_units not in TIME_UNITS:
+            raise InputError(f"{literal(repr(self.time_units))} is not a unit of the time column; give one of "
+                             f"{', '.join(TIME_UNITS)}", "{time_units}")
+
+    @property
+    def separator(self) -> str:
+        """The field separator in effect (``','`` by default)."""
+        return self.delimiter or ","
+
+    @property
+    def plain(self) -> bool:
+        """No preamble, comment or delimiter given: the file is read as a plain CSV (the fast path)."""
+        return self.skip_rows == 0 and self.comment is None and self.delimiter is None
+
+    def given(self) -> list[str]:
+        """The text options given (their field names), for a file type they do not apply to."""
+        return [k for k in ("skip_rows", "comment", "delimiter") if getattr(self, k) not in (0, None)]
+
+    def to_dict(self) -> dict:
+        """The options as a result's ``inputs`` records them (``delimiter`` as typed words for tab and space)."""
+        d = asdict(self)
+        d["delimiter"] = {"\t": "tab", " ": "space"}.get(self.delimiter, self.delimiter)
+        return d
+
+
+def _rate(step: float, unit: str) -> float:
+    return 1.0 / (step * TIME_UNITS[unit])
+
+
+def _in_band(step: float, unit: str) -> bool:
+    lo, hi = RATE_BAND_HZ
+    return lo * (1 - 1e-9) <= _rate(step, unit) <= hi * (1 + 1e-9)
+
+
+def _detect(step: float) -> str | None:
+    for unit, lo, hi in _DETECT:
+        if lo <= step <= hi:
+            return unit
+    return None
+
+
+def time_unit(step: float, column: str, where: str, given: str | None = None) -> tuple[str, bool]:
+    """The unit of a time column from its median step, or the given unit checked against it.
+
+    Parameters
+    ----------
+    step : float
+        Median difference of consecutive time stamps, in the file's numbers. A step that is not a
+        finite number > 0 (time that does not increase) is taken in ``given`` or seconds unchecked:
+        the time checks that follow name the row.
+    column : str
+        Name of the time column, for the message.
+    where : str
+        The file, for the message.
+    given : str, optional
+        The unit stated by the user (a key of :data:`TIME_UNITS`); None: detect it.
+
+    Returns
+    -------
+    unit : str
+        A key of :data:`TIME_UNITS`.
+    detected : bool
+        True when the unit was detected, False when given (or unchecked).
+
+    Raises
+    ------
+    InputError
+        No unit puts the rate within :data:`RATE_BAND_HZ`, or the given unit does not; the message
+        names the time column and the fix (``{time_units=ms}``, ``{columns}``, ``{rate_hz}``).
+    """
+    if not (math.isfinite(step) and step > 0):
+        return given or "s", False
+    found = _detect(step)
+    name = f"time column '{literal(column)}'"
+    band = f"{RATE_BAND_HZ[0]:g} Hz to {RATE_BAND_HZ[1] / 1e3:g} kHz"
+    if given is None:
+        if found is None:
+            rates = ", ".join(f"as {u}: {_rate(step, u):.3g} Hz" for u in ("s", "ns"))
+            raise InputError(f"{name}: its median step {step:.4g} is no IMU sample interval in s, ms, us or ns "
+                             f"({rates}; {band} expected); name the time column with {{columns}}, or read the log "
+                             "without it with {rate_hz}", where)
+        return found, True
+    if _in_band(step, given):
+        return given, False
+    fix = (f"the step suggests {{time_units={found}}}" if found is not None and found != given
+           else "check the time column ({columns}), or read the log without it ({rate_hz})")
+    raise InputError(f"{name} in {given}: its median step {step:.4g} {given} is {_rate(step, given):.3g} Hz, not an "
+                     f"IMU sample rate ({band}); {fix}", where)
+
+
+# ---- text sources for pyarrow's CSV reader ----
+
+
+def _raw_bytes(p: Path) -> bytes:
+    """The file's bytes (a ``.gz`` file decompressed)."""
+    if p.suffix.lower() == ".gz":
+        try:
+            return gzip.decompress(p.read_bytes())
+        except (OSError, EOFError, ValueError, zlib.error) as exc:
+            raise InputError(f"cannot read the compressed file ({literal(exc)})", str(p)) from None
+    return p.read_bytes()
+
+
+def _strip_comments(data: bytes, comment: str) -> bytes:
+    """``data`` with everything from ``comment`` to the end of each line removed (with the blanks before it);
+    the line ends stay, so line numbers hold and lines left empty are skipped by the CSV reader.
+
+    Walks the comments only (``bytes.find``), so a large log with few comments costs about one copy.
+    """
+    c, pieces, pos = comment.encode(), [], 0
+    at = data.find(c)
+    while at >= 0:
+        end = data.find(b"\n", at)
+        end = len(data) if end < 0 else end
+        cut = at
+        while cut > pos and data[cut - 1] in (32, 9):   # the blanks before the comment
+            cut -= 1
+        pieces.append(data[pos:cut])
+        pos = end - 1 if data[end - 1 : end] == b"\r" else end   # the line end stays
+        at = data.find(c, end)
+    pieces.append(data[pos:])
+    return b"".join(pieces)
+
+
+def _blanks_to_commas(data: bytes) -> bytes:
+    """Fields separated by runs of blanks (``'space'``), leading and trailing blanks dropped, as CSV
+    (``bytes.replace`` passes only, at C speed: a run of k blanks takes log2(k) passes)."""
+    data = data.replace(b"\t", b" ")
+    while b"  " in data:
+        data = data.replace(b"  ", b" ")
+    data = data.replace(b" ", b",")
+    data = data.replace(b"\n,", b"\n").replace(b",\r\n", b"\r\n").replace(b",\n", b"\n")
+    data = data[1:] if data.startswith(b",") else data
+    return data[:-1] if data.endswith(b",") else data
+
+
+def csv_source(p: Path, fmt: LogFormat):
+    """What pyarrow's CSV reader is given for a text log read with ``fmt``.
+
+    Returns
+    -------
+    open : callable
+        ``open()`` -> a fresh source (the path, or a buffer reader over the prepared bytes).
+    read_options, parse_options : dict
+        Keyword arguments of ``pyarrow.csv.ReadOptions`` and ``ParseOptions``.
+
+    Notes
+    -----
+    Without a comment character found in the file and without ``'space'`` the file goes to pyarrow
+    as it is (``skip_rows`` and ``delimiter`` are pyarrow's own options): no copy is made. Otherwise
+    its bytes are prepared once (bytes.find and bytes.replace, not a Python loop over the lines).
+    """
+    read = {"skip_rows": fmt.skip_rows} if fmt.skip_rows else {}
+    parse = {"delimiter": fmt.delimiter} if fmt.delimiter not in (None, ",", " ") else {}
+    if fmt.comment is None and fmt.delimiter != " ":
+        return (lambda: p), read, parse
+    data = _raw_bytes(p)
+    if fmt.comment is not None and fmt.comment.encode() not in data and fmt.delimiter != " ":
+        return (lambda: p), read, parse
+    import pyarrow as pa
+
+    head, body = _split_lines(data, fmt.skip_rows)
+    if fmt.comment is not None:
+        body = _strip_comments(body, fmt.comment)
+    if fmt.delimiter == " ":
+        body = _blanks_to_commas(body)
+    buffer = pa.py_buffer(body)
+    return (lambda: pa.BufferReader(buffer)), {}, parse
+
+
+def _split_lines(data: bytes, n: int) -> tuple[bytes, bytes]:
+    """The first ``n`` lines of ``data`` and the rest."""
+    pos = 0
+    for _ in range(n):
+        nl = data.find(b"\n", pos)
+        if nl < 0:
+            return data, b""
+        pos = nl + 1
+    return data[:pos], data[pos:]
+
+
+def _head(p: Path, size: int = 1 << 16) -> bytes:
+    """The first ``size`` bytes of the file (decompressed for ``.gz``)."""
+    try:
+        if p.suffix.lower() == ".gz":
+            with gzip.open(p, "rb") as fh:
+                return fh.read(size)
+        with open(p, "rb") as fh:
+            return fh.read(size)
+    except (OSError, EOFError, zlib.error):
+        return b""
+
+
+def content_lines(p: Path, fmt: LogFormat, limit: int = 200) -> list[tuple[int, str]]:
+    """Up to ``limit`` lines of the file's head that hold data (``(line number, text)``; 1-based), after
+    ``skip_rows``, without comments and blank lines (a last, cut line is dropped)."""
+    text = _head(p).decode("utf-8", "replace").removeprefix("\ufeff")
+    lines = text.split("\n")
+    if len(lines) > 1:
+        lines = lines[:-1]
+    out = []
+    for number, line in enumerate(lines[fmt.skip_rows:], fmt.skip_rows + 1):
+        if fmt.comment is not None:
+            line = line.split(fmt.comment, 1)[0]
+        if line.strip():
+            out.append((number, line.rstrip("\r")))
+        if len(out) >= limit:
+            break
+    return out
+
+
+def _fields(line: str, fmt: LogFormat) -> int:
+    return len(line.split()) if fmt.delimiter == " " else line.count(fmt.separator) + 1
+
+
+def preamble_hint(p: Path, fmt: LogFormat) -> str | None:
+    """Advice for a text log the CSV reader could not read: a preamble to skip, comments, another delimiter.
+
+    Looks at the file's head: lines starting with ``#`` (comments: ``{comment=#}``); first lines with
+    fewer fields than the lines after them (a logger's metadata before the header: ``{skip_rows=N}``,
+    N counted from the top of the file); a header of one field holding ``;``, a tab or blanks
+    (``{delimiter=...}``).
+
+    Returns
+    -------
+    str or None
+        One clause for the message, None when nothing explains the failure.
+    """
+    lines = content_lines(p, fmt)
+    mark = "#" if fmt.comment is None and any(text.lstrip().startswith("#") for _, text in lines) else None
+    body = [(n, text) for n, text in lines if mark is None or not text.lstrip().startswith(mark)]
+    found, advice = [], []
+    counts = [_fields(text, fmt) for _, text in body]
+    start = len(counts)
+    while start > 0 and counts[start - 1] == counts[-1]:
+        start -= 1
+    if 0 < start < len(counts) - 1 and all(c < counts[-1] for c in counts[:start]):
+        first, shown = body[start][0], sorted(set(counts[:start]))
+        found.append(f"its first {_lines(first - 1)} {'hold' if first > 2 else 'holds'} {' or '.join(map(str, shown))} "
+                     f"field{'s' if shown != [1] else ''} and the lines from line {first} on hold {counts[-1]} (a "
+                     "logger's preamble before the header?)")
+        advice.append(f"{{skip_rows={first - 1}}}")
+        after = [n for n, text in lines if n > first and mark is not None and text.lstrip().startswith(mark)]
+    else:
+        after = [n for n, text in lines if mark is not None and text.lstrip().startswith(mark)]
+    if after:
+        found.append(f"line {after[0]} starts with '{mark}' (a comment?)")
+        advice.append(f"{{comment={mark}}}")
+    if found:
+        return f"{' and '.join(found)}: give {' and '.join(advice)}"
+    if fmt.delimiter is None and body and counts[0] == 1:
+        header = body[0][1]
+        for char, word in ((";", ";"), ("\t", "tab"), ("|", "|")):
+            if char in header:
+                return f"its header holds no ',' but {'tabs' if word == 'tab' else repr(word)}: give {{delimiter={word}}}"
+        if len(header.split()) > 1:
+            return "its fields are separated by blanks: give {delimiter=space}"
+    return None
+
+
+def _lines(n: int) -> str:
+    return "line" if n == 1 else f"{n} lines"
