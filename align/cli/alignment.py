@@ -24,7 +24,8 @@ Log = opt.Arg("Gyro log: .csv, .csv.gz, .npy or .parquet.", "LOG")
 
 def matrix(
     log: Log,
-    plan: opt.Input("--plan", "Test plan TOML: [[step]] tables with axis and rate or angle.", "PLAN.toml"),
+    plan: opt.Input("--plan", "Test plan TOML: [[step]] tables (axis, rate or angle), optional [mounting] and [test] "
+                    "(latitude, table_axis, rest).", "PLAN.toml"),
     method: opt.Choice("--method", ("auto", "rate", "angle", "lsq", "two-axis"),
                    "Estimator; auto: lsq for three turned axes, two-axis for two.") = "auto",
     gyro_units: opt.GyroUnits() = "deg/s",
@@ -50,16 +51,22 @@ def matrix(
                               "RATIO", TOLERANCE, "'5 %'") = "5 %",
     axis_to_axis: opt.Quantity("--axis-to-axis", "angle", "Axis-to-axis spec for the two-axis shortcut's error.",
                            "ANGLE", POSITIVE, "'0.05 deg'") = "0.05 deg",
+    scale_spec: opt.Quantity("--scale-spec", "dimensionless", "Scale-factor spec (1 sigma) of the gyro the two-axis "
+                             "shortcut cannot measure: its assumed scale's uncertainty.", "RATIO", TOLERANCE,
+                             "'1 %'") = "1 %",
     two_axis_variant: opt.Choice("--two-axis-variant", ("procrustes", "cross"),
                              "Two-axis shortcut: procrustes, or cross (the source's Eq 36).") = "procrustes",
-    earth: opt.Flag("--earth/--no-earth", "Correct the vertical Earth rate when the plan gives a latitude.") = True,
+    earth: opt.Flag("--earth/--no-earth", "Model the Earth rate, as far as the plan's table geometry allows, when it "
+                    "gives a latitude.") = True,
+    plot: opt.OptInput("--plot", "Picture of the segmentation: steps, static periods, ramps and motions left out (PNG).",
+                       "SEGMENTS.png") = None,
     skip_rows: opt.SkipRows = 0,
     comment: opt.Comment = None,
     delimiter: opt.Delimiter = None,
     time_units: opt.TimeUnits = None,
 ) -> None:
     """Alignment matrix M and A = M^-1 from rate-table data."""
-    check_outputs([log, plan, segments], json_out=json_out, c_header=c_header)
+    check_outputs([log, plan, segments], json_out=json_out, c_header=c_header, plot=plot)
     import align.io as fileio
     from align.alignment.job import AlignOptions, align
     from align.alignment.plan import Plan
@@ -74,7 +81,7 @@ def matrix(
     opts = AlignOptions(method=value(method), two_axis_variant=value(two_axis_variant), axis_to_axis=axis_to_axis,
                         segmentation=SegmentOptions(window_s=window, margin_s=margin, static_threshold=static_threshold),
                         min_dwell=min_dwell, rate_tolerance=rate_tolerance, scale_tolerance=scale_tolerance,
-                        gyro_range=gyro_range, earth_correction=earth)
+                        gyro_range=gyro_range, earth_correction=earth, scale_spec=scale_spec)
     segs = None if segments is None else segments_from_ranges(fileio.read_json(segments), the_plan, len(t), str(segments))
     result = align(t, g, the_plan, opts, segs, got.shown, str(log))
     result = result.replace(inputs={"log": str(log), "plan": str(plan), "gyro_units": gyro_units, "columns": columns,
@@ -85,6 +92,10 @@ def matrix(
             out.write_json(json_out, result)
         if c_header is not None:
             out.write_text(c_header, result.as_c_header(f"imu-align alignment from {log.name}"))
+        if plot is not None:
+            from align.present.plots import segmentation_plot_png
+
+            out.write_bytes(plot, segmentation_plot_png(t, g, result, result.units))
     typer.echo(alignment_summary(result))
 
 

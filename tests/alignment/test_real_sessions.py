@@ -210,3 +210,22 @@ def test_step_missing_from_the_log_is_named():
     with pytest.raises(TestError, match=r"step 4 \(\+y at -100 deg/s\) not found after step 3") as err:
         align(sess.t, sess.g, plan)
     assert "\n" not in str(err.value)
+
+
+def test_the_reoriented_example_is_found_and_covered(run_cli, tmp_path):
+    """examples/alignment/reoriented: mounting detected, moves left out, east table axis, ms time, drifting bias."""
+    import json
+
+    from conftest import ROOT
+
+    here = ROOT / "examples/alignment/reoriented"
+    out = tmp_path / "out.json"
+    res = run_cli("matrix", here / "session.csv", "--plan", here / "plan.toml", "--json", out, "--plot",
+                  tmp_path / "seg.png")
+    assert res.code == 0, res.err
+    r, truth = json.loads(out.read_text()), json.loads((here / "truth.json").read_text())
+    assert np.all(np.abs(np.array(r["M"]) - truth["M"]) < 3 * np.array(r["uncertainty"]["M"]))
+    assert r["mounting"]["axes"] == ["+y", "-x", "+z"] and r["mounting"]["source"] == "detected"
+    assert len(r["motions"]) == len(truth["moves"]) == 2
+    assert r["inputs"]["time_units"] == "ms"
+    assert (tmp_path / "seg.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
