@@ -81,7 +81,7 @@ class Manoeuvre(Value):
 #: the tables of a manoeuvre file and the keys of each (``[limits]``: the outputs, see ``OUTPUTS``)
 MANOEUVRE_KEYS = ("rotation", "series", "limits")
 ROTATION_KEYS = ("axis", "angle")
-SERIES_KEYS = ("file", "columns", "units")
+SERIES_KEYS = ("file", "columns", "units", "time_units")
 #: the largest turn (deg) one [[rotation]] may give: beyond, the number or its unit is wrong
 MAX_ANGLE_DEG = 1e5
 
@@ -179,7 +179,7 @@ def _series_columns(series: dict, where: str) -> list[str]:
 
 def _series(series: dict, limits: dict, where: str, base_dir) -> Manoeuvre:
     """A ``[series]`` of body rates, integrated by the trapezoid rule into increments."""
-    from align.io import check_log, check_time, read_log
+    from align.io import LogFormat, check_log, check_time, read_log
 
     check_keys(series, SERIES_KEYS, f"{where}: [series]")
     path = file_name(series, "file", f"{where}: series.file", "rates.csv", base_dir)
@@ -188,7 +188,10 @@ def _series(series: dict, limits: dict, where: str, base_dir) -> Manoeuvre:
     if not isinstance(units, str):
         raise InputError(f"expected a unit string (units = \"rad/s\"), got {literal(repr(units))}", f"{where}: series.units")
     parse_unit(units, "angular_rate", f"{where}: series.units")
-    t, w = read_log(path, cols[1:], units, cols[0])
+    time_units = series.get("time_units", "s")  # stated, not detected: a slow trajectory is no IMU log
+    if time_units not in ("s", "ms", "us", "ns"):
+        raise InputError(f"expected one of s, ms, us, ns, got {literal(repr(time_units))}", f"{where}: series.time_units")
+    t, w = read_log(path, cols[1:], units, cols[0], log_format=LogFormat(time_units=time_units))
     check_log(t, w, str(path), min_rows=2)
     check_time(t, str(path), gap=1.5)
     inc = 0.5 * (w[1:] + w[:-1]) * np.diff(t)[:, None]   # trapezoid increments

@@ -14,6 +14,19 @@ from align.values import approx_equal
 EXAMPLE2 = ROOT / "examples" / "sensitivity" / "example2.toml"
 
 
+def test_slow_rate_series_time_is_seconds_unless_stated(tmp_path):
+    """A 5 Hz trajectory's steps (0.2) would look like ms to a detector: a series' time is stated, not guessed."""
+    t = np.arange(0, 10.0, 0.2)
+    csv = tmp_path / "rates.csv"
+    csv.write_text("time,wx,wy,wz\n" + "\n".join(f"{a:.6f},0,0,10" for a in t) + "\n")
+    man = manoeuvre_from_dict({"series": {"file": "rates.csv"}, "limits": {"y": "1 deg"}}, "m", tmp_path)
+    assert man.increments.sum(axis=0)[2] == pytest.approx(10 * DEG * t[-1], rel=1e-9)  # 98 deg, not 0.098
+    csv.write_text("time,wx,wy,wz\n" + "\n".join(f"{1000 * a:.3f},0,0,10" for a in t) + "\n")
+    man = manoeuvre_from_dict({"series": {"file": "rates.csv", "time_units": "ms"}, "limits": {"y": "1 deg"}}, "m",
+                              tmp_path)
+    assert man.increments.sum(axis=0)[2] == pytest.approx(10 * DEG * t[-1], rel=1e-9)
+
+
 def test_rate_series_fixed_axis_matches_and_gap_is_refused(tmp_path):
     t = np.arange(0, 3.0, 0.01)
     rate = 20.0 * np.sin(np.pi * t / 3.0)  # deg/s about z, a smooth 38 deg turn
@@ -71,7 +84,7 @@ LIMITS = '[limits]\ny = "1 deg"\nz = "1 deg"\n'
 
 @pytest.mark.parametrize("text,words", [
     ('[series]\nfile = "rates.csv"\nunit = "rad/s"\n' + LIMITS,
-     "m.toml: [series]: unknown key 'unit' (did you mean 'units'? known: file, columns, units)"),
+     "m.toml: [series]: unknown key 'unit' (did you mean 'units'? known: file, columns, units, time_units)"),
     ('[series]\nfile = "rates.csv"\ncolumn = "t,a,b,c"\n' + LIMITS, "[series]: unknown key 'column' (did you mean 'columns'?"),
     ('[series]\nfile = "rates.csv"\nunits = "rad"\n' + LIMITS, "m.toml: series.units"),
     ('[series]\nfile = "rates.csv"\nunits = 57.3\n' + LIMITS, "series.units: expected a unit string"),
