@@ -37,6 +37,10 @@ def report(
                        optional=False) = "0.1 deg",
     monte_carlo: opt.MonteCarlo("Monte Carlo draws of the budget.") = 100_000,
     seed: opt.Seed = 0,
+    skip_rows: opt.SkipRows = 0,
+    comment: opt.Comment = None,
+    delimiter: opt.Delimiter = None,
+    time_units: opt.TimeUnits = None,
 ) -> None:
     """One self-contained HTML report: budget, allowance, noise plan and alignment."""
     from align.errors import InputError
@@ -50,7 +54,7 @@ def report(
         page, summary, _ = build_report(
             mount, manoeuvre, log=log, plan=plan, allan=allan_log, allan_columns=columns, allan_rate_hz=rate_hz,
             allan_units=units, gyro_units=gyro_units, table_rate=rate, accuracy=accuracy, monte_carlo=monte_carlo,
-            seed=seed, progress=tick)
+            seed=seed, progress=tick, log_format=opt.log_format(skip_rows, comment, delimiter, time_units))
     with outputs() as staged:
         staged.write_text(out, page)
     typer.echo(summary + f"\nreport: {out}")

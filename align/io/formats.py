@@ -313,17 +313,21 @@ def content_lines(p: Path, fmt: LogFormat, limit: int = 200) -> list[tuple[int, 
     return out
 
 
-def _fields(line: str, fmt: LogFormat) -> int:
-    return len(line.split()) if fmt.delimiter == " " else line.count(fmt.separator) + 1
+def _fields(line: str, sep: str) -> int:
+    return len(line.split()) if sep == " " else line.count(sep) + 1
+
+
+#: the separators a text log may use, tried in this order when none is given, with their option spelling
+_SEPARATORS = ((",", ","), (";", ";"), ("\t", "tab"), ("|", "|"), (" ", "space"))
 
 
 def preamble_hint(p: Path, fmt: LogFormat) -> str | None:
     """Advice for a text log the CSV reader could not read: a preamble to skip, comments, another delimiter.
 
-    Looks at the file's head: lines starting with ``#`` (comments: ``{comment=#}``); first lines with
-    fewer fields than the lines after them (a logger's metadata before the header: ``{skip_rows=N}``,
-    N counted from the top of the file); a header of one field holding ``;``, a tab or blanks
-    (``{delimiter=...}``).
+    Looks at the file's head: lines starting with ``#`` (comments: ``{comment=#}``); the separator that splits
+    the last lines into several fields (the given one, else the first of ``, ; tab | blanks`` that does:
+    ``{delimiter=...}`` when it is not the comma); first lines with fewer fields than the lines after them (a
+    logger's metadata before the header: ``{skip_rows=N}``, N counted from the top of the file).
 
     Returns
     -------
@@ -333,8 +337,16 @@ def preamble_hint(p: Path, fmt: LogFormat) -> str | None:
     lines = content_lines(p, fmt)
     mark = "#" if fmt.comment is None and any(text.lstrip().startswith("#") for _, text in lines) else None
     body = [(n, text) for n, text in lines if mark is None or not text.lstrip().startswith(mark)]
+    if not body:
+        return None
+    given = fmt.separator if fmt.delimiter is not None else None
+    tried = [(given, None)] if given is not None else list(_SEPARATORS)
+    sep, word = next(((c, w) for c, w in tried if _fields(body[-1][1], c) > 1), tried[0])
     found, advice = [], []
-    counts = [_fields(text, fmt) for _, text in body]
+    if given is None and word != ",":
+        found.append(f"its fields are separated by {'blanks' if word == 'space' else 'tabs' if word == 'tab' else repr(word)}")
+        advice.append(f"{{delimiter={word}}}")
+    counts = [_fields(text, sep) for _, text in body]
     start = len(counts)
     while start > 0 and counts[start - 1] == counts[-1]:
         start -= 1
@@ -350,16 +362,7 @@ def preamble_hint(p: Path, fmt: LogFormat) -> str | None:
     if after:
         found.append(f"line {after[0]} starts with '{mark}' (a comment?)")
         advice.append(f"{{comment={mark}}}")
-    if found:
-        return f"{' and '.join(found)}: give {' and '.join(advice)}"
-    if fmt.delimiter is None and body and counts[0] == 1:
-        header = body[0][1]
-        for char, word in ((";", ";"), ("\t", "tab"), ("|", "|")):
-            if char in header:
-                return f"its header holds no ',' but {'tabs' if word == 'tab' else repr(word)}: give {{delimiter={word}}}"
-        if len(header.split()) > 1:
-            return "its fields are separated by blanks: give {delimiter=space}"
-    return None
+    return f"{' and '.join(found)}: give {' and '.join(advice)}" if found else None
 
 
 def _lines(n: int) -> str:

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from align.io import read_log, read_static, read_toml
+from align.io import LogFormat, read_sensor_log, read_static, read_toml
 from align.io.outputs import Outputs
 from align.units import DEG, DEG_H, parse_unit
 from align.units import parse_quantity as q
@@ -82,11 +82,14 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
                  allan_units: str = "deg/s", gyro_units: str = "deg/s", table_rate: str = "100 deg/s",
                  accuracy: str = "0.1 deg", noise_ratio: float = 10.0, monte_carlo: int = 100_000, seed: int = 0,
                  basis: str = "rss", progress=None, title: str = "IMU alignment report",
-                 source: Callable[[Path], Path] | None = None) -> tuple[str, str, dict]:
+                 source: Callable[[Path], Path] | None = None,
+                 log_format: LogFormat | None = None) -> tuple[str, str, dict]:
     """Run every job whose inputs are given; return (HTML, summary text, results).
 
     The inputs are named by their paths; ``source`` maps such a path to the file to read, when
     that differs (the demo reads its staged inputs: :meth:`align.io.outputs.Outputs.staged`).
+    ``log_format`` (a logger file's preamble, comments, delimiter, time unit) applies to the
+    rate-table log and the static record alike.
     """
     import align.present.html as report
     from align.sensitivity import allowable, check_margins, manoeuvre_from_dict
@@ -118,7 +121,7 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
 
         names = [c.strip() for c in allan_columns.split(",")]
         parse_unit(allan_units, "angular_rate", "{allan_units}")  # the plan needs a gyro's record
-        data, fs = read_static(src(allan), names, allan_rate_hz)
+        data, fs = read_static(src(allan), names, allan_rate_hz, log_format)
         job = run_allan([data], fs, names, allan_units, where=str(allan))
         pl = plan_from_allan(job, q(table_rate, "angular_rate", "{rate}"), q(accuracy, "angle", "{accuracy}"), noise_ratio,
                              "measured curve (worst channel)")
@@ -136,8 +139,11 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
         from align.present.plots import segmentation_plot_png
 
         the_plan = Plan.from_dict(read_toml(src(plan)), str(plan))
-        t, g = read_log(src(log), ["gyro_x", "gyro_y", "gyro_z"], gyro_units)
-        r = align(t, g, the_plan, units=gyro_units, where=str(log))
+        got = read_sensor_log(src(log), ["gyro_x", "gyro_y", "gyro_z"], gyro_units, log_format=log_format)
+        t, g = got.t, got.data
+        r = align(t, g, the_plan, units=got.shown, where=str(log))
+        if got.time_note():
+            r = r.replace(notes=r.notes + (got.time_note(),))
         sections.append(report.alignment_section(r, segmentation_plot_png(t, g, r, r.units)))
         inputs["rate-table log"] = (str(log), "")
         inputs["plan"] = (str(plan), _text(src(plan)))

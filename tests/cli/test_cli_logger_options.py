@@ -247,3 +247,22 @@ def test_calibrate_mag_with_semicolons_and_a_preamble(run_cli, tmp_path):
     assert res.code == 0, res.err
     a, b = json.loads(ref.read_text()), json.loads(got.read_text())
     assert a["hard_iron"] == b["hard_iron"] and b["inputs"]["delimiter"] == ";" and b["inputs"]["skip_rows"] == 2
+
+
+def test_report_reads_a_logger_file_with_its_options(tmp_path, run_cli):
+    """The report's rate-table log goes through the same reader options as matrix (issue 12)."""
+    src = ROOT / "examples/alignment"
+    rows = (src / "session.csv").read_text().splitlines()
+    log = tmp_path / "logger.csv"
+    log.write_text("logger v2\nsample rate,100\n" + "\n".join(r.replace(",", ";") for r in rows) + "\n")
+    out = tmp_path / "r.html"
+    args = ("report", "--mount", ROOT / "examples/budget/example1.toml", "--manoeuvre",
+            ROOT / "examples/sensitivity/example2.toml", "--log", log, "--plan", src / "plan.toml", "--out", out,
+            "--monte-carlo", "1000")
+    res = run_cli(*args)
+    assert res.code == 2 and "--skip-rows 2" in res.err and not out.exists()
+    res = run_cli(*args, "--skip-rows", "2", "--delimiter", ";")
+    assert res.code == 0, res.err
+    plain = run_cli("matrix", src / "session.csv", "--plan", src / "plan.toml")
+    psi = next(line for line in plain.out.splitlines() if "psi (axis-frame)" in line)
+    assert "alignment: psi" in res.out and psi.split()[2][2:7] in res.out
