@@ -354,7 +354,12 @@ def calibrate_accel_free(means: np.ndarray, gravity: float = STANDARD_GRAVITY, u
     m = np.linalg.inv(u)
     dof = max(k - 9, 1)
     s2 = float(np.sum(sol.fun**2)) / dof
-    cov = np.linalg.pinv(sol.jac.T @ sol.jac) * s2
+    # columns scaled to unit norm first: in raw counts U (~1e-4) and b (~1e3) differ by 1e7, and an unscaled
+    # pseudo-inverse would drop the small directions (a bias sigma 500x too small)
+    norms = np.linalg.norm(sol.jac, axis=0)
+    norms[norms == 0] = 1.0
+    js = sol.jac / norms
+    cov = np.linalg.pinv(js.T @ js) / np.outer(norms, norms) * s2
     # 1-sigma of M = U^-1 by first-order propagation dM = -M dU M
     sig_u = np.zeros((3, 3))
     sig_u[iu] = np.sqrt(np.diag(cov)[:6])

@@ -63,3 +63,26 @@ def test_accel_session_from_positions_and_its_errors():
         accel_session(t, a, intervals, [explicit[0]] + positions[1:], g, "m/s^2", positions_file="pos.toml")
     with pytest.raises(InputError, match="up must be an axis"):
         accel_session(t, a, intervals, [{**positions[0], "up": 3}] + positions[1:], g, "m/s^2")
+
+
+@pytest.mark.parametrize("counts_per_unit", [1.0, 1670.0])
+def test_free_fit_uncertainty_scales_with_the_unit_and_covers_the_truth(counts_per_unit):
+    """The |a| = g fit's sigmas must not depend on the unit of the readings (in raw counts the parameters span
+    1e7 and an unscaled pseudo-inverse dropped directions: a bias sigma 500x too small); over seeds the bias
+    lies inside 3 sigma."""
+    from accelsim import attitudes
+
+    from align.calibration.accel import calibrate_accel_free
+
+    m_true = np.array([[1.01, 0.002, -0.003], [0.001, 0.99, 0.004], [0.0, 0.0, 1.005]])
+    b_true = np.array([0.3, -0.2, 0.1])
+    z = []
+    for seed in range(20):  # 20 attitudes: 11 degrees of freedom for the residual scale
+        means, _, _ = attitudes(m_true, b_true, 9.80665, k=20, seed=seed)
+        rng = np.random.default_rng(seed)
+        means = means + rng.normal(0, 0.01, means.shape)  # attitude-to-attitude scatter of 0.01 m/s^2
+        ref = calibrate_accel_free(means)
+        cal = calibrate_accel_free(means * counts_per_unit, units="counts")
+        assert np.allclose(cal.sigma_bias, ref.sigma_bias * counts_per_unit, rtol=1e-4)
+        z.append((ref.bias - b_true) / ref.sigma_bias)
+    assert np.mean(np.abs(np.array(z)) < 3) > 0.95
