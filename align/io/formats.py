@@ -7,26 +7,17 @@ says how to read such a file; every log reader (:mod:`align.io.logs`) takes one,
 reads a plain CSV by its fastest path, unchanged.
 
 The time column's unit is detected from the median sample interval unless given
-(:func:`time_unit`): a MEMS IMU samples between about 1 Hz and 100 kHz, and typically between
-10 Hz and 10 kHz, so the unit is the one of s, ms, us, ns that puts the median step's rate in
-10 Hz - 10 kHz (seconds up to 100 kHz, nanoseconds down to 1 Hz):
-
-=========================  ======
-median step (file units)   unit
-=========================  ======
-1e-5 to 0.1                s
-0.1 to 100                 ms
-100 to 1e5                 us
-1e5 to 1e9                 ns
-=========================  ======
-
-A step outside these, or a given unit that puts the rate outside 1 Hz - 100 kHz, is refused naming
-the time column and the fix. The one ambiguity left is inherent: a 1-10 Hz log in seconds reads
-like a 1-10 kHz log in milliseconds (give the unit then); the detected unit is stated with the result.
+(:func:`time_unit`): a MEMS IMU log samples between about 1 Hz and 10 kHz, so the unit is the one of
+s, ms, us, ns that puts the median step's rate in :data:`DETECT_BAND_HZ` (seconds also up to
+100 kHz). When two units do (a step of 1 is a 1 Hz log in s or a 1 kHz log in ms; 0.1 to 1 and 100
+to 1000 and 1e5 to 1e6 likewise), the unit is not guessed: the log is refused with both readings and
+the option to choose. A step no unit explains, or a given unit that puts the rate outside
+:data:`RATE_BAND_HZ`, is refused naming the time column and the fix. A detected unit other than
+seconds is stated with the result.
 
 Public names
 ------------
-LogFormat, TIME_UNITS, DELIMITERS, RATE_BAND_HZ, delimiter_char, time_unit, csv_source, preamble_hint,
+LogFormat, TIME_UNITS, DELIMITERS, RATE_BAND_HZ, DETECT_BAND_HZ, delimiter_char, time_unit, csv_source, preamble_hint,
 content_lines
 """
 
@@ -44,8 +35,8 @@ from align.errors import InputError, literal
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 #: the sample rates an IMU log may have, Hz (outside: not a sample interval, or the wrong time unit)
 RATE_BAND_HZ = (1.0, 1e5)
-#: the median step (in the file's numbers) up to which each unit is detected (see the module's table)
-_DETECT = (("s", 1e-5, 0.1), ("ms", 0.1, 100.0), ("us", 100.0, 1e5), ("ns", 1e5, 1e9))
+#: the sample rates a unit is detected for, Hz (seconds also up to the top of :data:`RATE_BAND_HZ`)
+DETECT_BAND_HZ = (1.0, 1e4)
 #: names of delimiters that are awkward to type
 DELIMITERS = {"tab": "\t", "\\t": "\t", "space": " ", "comma": ",", "semicolon": ";", "pipe": "|"}
 #: characters that can be neither a delimiter nor a comment: they are parts of numbers, quotes or line ends
@@ -136,14 +127,14 @@ def _in_band(step: float, unit: str) -> bool:
     return lo * (1 - 1e-9) <= _rate(step, unit) <= hi * (1 + 1e-9)
 
 
-def _detect(step: float) -> str | None:
-    for unit, lo, hi in _DETECT:
-        if lo <= step <= hi:
-            return unit
-    return None
+def _detect(step: float) -> list[str]:
+    """The units that put the step's rate in :data:`DETECT_BAND_HZ` (seconds: up to 100 kHz)."""
+    lo, hi = DETECT_BAND_HZ
+    return [u for u in TIME_UNITS if lo * (1 - 1e-9) <= _rate(step, u) <= (RATE_BAND_HZ[1] if u == "s" else hi) * (1 + 1e-9)]
 
 
-def time_unit(step: float, column: str, where: str, given: str | None = None) -> tuple[str, bool]:
+def time_unit(step: float, column: str, where: str, given: str | None = None,
+              first: float | None = None) -> tuple[str, bool]:
     """The unit of a time column from its median step, or the given unit checked against it.
 
     Parameters
@@ -158,6 +149,9 @@ def time_unit(step: float, column: str, where: str, given: str | None = None) ->
         The file, for the message.
     given : str, optional
         The unit stated by the user (a key of :data:`TIME_UNITS`); None: detect it.
+    first : float, optional
+        The first time stamp: a Unix epoch (1973 to 2286 in one of the units) settles a step two units
+        would explain.
 
     Returns
     -------
@@ -174,10 +168,18 @@ def time_unit(step: float, column: str, where: str, given: str | None = None) ->
     """
     if not (math.isfinite(step) and step > 0):
         return given or "s", False
-    found = _detect(step)
+    units = _detect(step)
+    if len(units) > 1 and first is not None:  # an epoch time stamp tells the unit
+        units = [u for u in units if 1e8 <= first * TIME_UNITS[u] <= 1e10] or units
+    found = units[0] if len(units) == 1 else None
     name = f"time column '{literal(column)}'"
     band = f"{RATE_BAND_HZ[0]:g} Hz to {RATE_BAND_HZ[1] / 1e3:g} kHz"
     if given is None:
+        if len(units) > 1:
+            readings = " or ".join(f"{_rate(step, u):.4g} Hz in {u}" for u in units)
+            choose = " or ".join(f"{{time_units={u}}}" for u in units)
+            raise InputError(f"{name}: its median step {step:.4g} reads as {readings}: the unit cannot be told from the "
+                             f"file; give {choose}", where)
         if found is None:
             rates = ", ".join(f"as {u}: {_rate(step, u):.3g} Hz" for u in ("s", "ns"))
             raise InputError(f"{name}: its median step {step:.4g} is no IMU sample interval in s, ms, us or ns "

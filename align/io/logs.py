@@ -130,7 +130,7 @@ class SensorLog:
 def _time_of(raw: np.ndarray, column: str, where: str, fmt: LogFormat) -> tuple[np.ndarray, str, bool]:
     """Time in s from a time column's numbers; its unit detected or given (:func:`~align.io.formats.time_unit`)."""
     step = float(np.median(np.diff(raw))) if len(raw) > 1 else float("nan")
-    unit, detected = time_unit(step, column, where, fmt.time_units)
+    unit, detected = time_unit(step, column, where, fmt.time_units, float(raw[0]) if len(raw) else None)
     return (raw * TIME_UNITS[unit] if unit != "s" else raw), unit, detected
 
 

@@ -73,8 +73,18 @@ def test_delimiter_names_and_the_format_as_results_record_it():
 @pytest.mark.parametrize("fs", [12.5, 50.0, 100.0, 200.0, 1000.0, 2000.0, 4000.0, 8000.0])
 @pytest.mark.parametrize("unit, size", [("s", 1.0), ("ms", 1e-3), ("us", 1e-6), ("ns", 1e-9)])
 def test_the_time_unit_is_detected_for_every_usual_imu_rate(fs, unit, size):
+    """Detected when one unit alone gives 1 Hz - 10 kHz; from 1 kHz up a step in ms, us or ns also reads as 1-10 Hz
+    in the next larger unit: then refused with both readings (a guess would be a silent factor of 1000), unless
+    the time stamps are a Unix epoch."""
     step = 1.0 / fs / size   # the step as the file holds it
-    assert time_unit(step, "time", "log") == (unit, True)
+    if unit == "s" or fs < 1000:
+        assert time_unit(step, "time", "log") == (unit, True)
+    else:
+        with pytest.raises(InputError, match="the unit cannot be told from the file") as err:
+            time_unit(step, "time", "log")
+        assert err.value.fields == ["time_units", "time_units"] and f"{fs:g} Hz in {unit}" in str(err.value)
+    epoch = 1.7e9 / size  # 2023 in the file's unit
+    assert time_unit(step, "time", "log", first=epoch) == (unit, True)
 
 
 def test_seconds_up_to_100_khz_and_nanoseconds_down_to_1_hz():
