@@ -14,7 +14,7 @@ axis (a flipped axis or swapped positions is a handedness error).
 
 Public names
 ------------
-check_gravity, check_at_rest, check_field_strength, check_known_field, check_corrected, check_dip, check_axes,
+check_gravity, check_at_rest, check_static_rates, check_field_strength, check_known_field, check_corrected, check_dip, check_axes,
 check_scale_factors, scale_outside,
 check_usable_model, check_positive_definite, require_finite, array_field, malformed, mixup_hint,
 ACCELERATION_UNITS, FIELD_UNITS, GRAVITY_RANGE, EARTH_FIELD, FIELD_RANGE, AT_REST_RANGE, MAX_CONDITION
@@ -42,6 +42,8 @@ EARTH_FIELD = (20e-6, 70e-6)
 FIELD_RANGE = (10e-6, 140e-6)
 #: mean |a| at rest over local gravity accepted for an accelerometer in physical units
 AT_REST_RANGE = (0.5, 2.0)
+#: the largest mean rate a gyro at rest may read, rad/s (MEMS zero-rate offsets reach +/-20-30 deg/s; 50 deg/s)
+STATIC_RATE_MAX = 50 * math.pi / 180
 #: condition number beyond which a matrix is not a usable correction
 MAX_CONDITION = 1e8
 
@@ -159,6 +161,38 @@ def check_at_rest(norms: np.ndarray, gravity: float, units: str, field: str = "u
         hint = (f"not a known unit mix-up: check {{{field}}} and the columns (an accelerometer at rest reads gravity)"
                 if mean > 0 else f"the readings are zero: check the columns and {{{field}}}")
     raise TestError(f"{said}: {hint}", where)
+
+
+def check_static_rates(means: np.ndarray, units: str, names: list[str], field: str = "gyro_units",
+                       where: str | None = None) -> None:
+    """Refuse a static gyro record whose mean rate on a channel no gyro at rest reads (raw counts read as a rate).
+
+    Parameters
+    ----------
+    means : ndarray, shape (C,)
+        Mean reading of each channel, rad/s, read with ``units``.
+    units : str
+        The declared unit of the readings (a rate unit, or a count size).
+    names : list of str
+        Channel names, C of them.
+    field : str
+        The library input holding ``units`` (the placeholder of the fix).
+    where : str, optional
+        The record, for the message.
+
+    Raises
+    ------
+    TestError
+        ``channel gx reads -428 deg/s on average, beyond the 50 deg/s any MEMS gyro at rest reads: ...``.
+    """
+    big = np.flatnonzero(~(np.abs(np.asarray(means, float)) <= STATIC_RATE_MAX))
+    if not len(big):
+        return
+    j = int(big[0])
+    said = (f"channel {literal(names[j])} reads {_num(means[j] * 180 / math.pi)} deg/s on average, beyond the "
+            f"{_num(STATIC_RATE_MAX * 180 / math.pi)} deg/s any MEMS gyro at rest reads")
+    raise TestError(f"{said}: raw counts read as {literal(units)}? give the size of one count, e.g. "
+                    f"{{{field}=131 LSB/(deg/s)}} for an MPU-6050 at +/-250 deg/s (or the record is not static)", where)
 
 
 def check_field_strength(strength: float, units: str, field: str = "units", where: str | None = None) -> None:

@@ -24,9 +24,9 @@ from align.noise.allan import NOISE_ALPHA, AllanResult, allan, edf_overlapping
 from align.noise.fit import NoiseFit, fit_noise
 from align.noise.model import TERMS, avar_design
 from align.noise.planner import PlanResult, make_plan
-from align.plausible import malformed
+from align.plausible import check_static_rates, malformed
 from align.results import Result, file_unit
-from align.units import parse_unit, to_unit
+from align.units import DIMENSIONS, parse_unit, to_unit
 
 FORMAT = "imu-align.allan"
 CONVENTION = ("overlapping Allan deviation (IEEE Std 1139, NIST SP 1065); noise model "
@@ -289,6 +289,8 @@ def run_allan(runs: list, fs: float, names: list[str], units: str, grid="dense",
     figures = tuple({"bias": float(np.mean([r.bias[j] for r in results])),
                      "stability": {p: float(np.mean([r.stability[p][j] for r in results])) for p in periods}}
                     for j in range(len(names)))
+    if parse_unit(units).dim == DIMENSIONS["angular_rate"][0].dim:  # raw counts read as a rate are refused
+        check_static_rates(np.array([f["bias"] for f in figures]), units, list(names), "gyro_units", files[0])
     rep = np.std([r.bias for r in results], axis=0, ddof=1) if len(results) > 1 else None
     return AllanJob(res, fits, figures, rep, units, len(runs))
 

@@ -266,3 +266,12 @@ def test_report_reads_a_logger_file_with_its_options(tmp_path, run_cli):
     plain = run_cli("matrix", src / "session.csv", "--plan", src / "plan.toml")
     psi = next(line for line in plain.out.splitlines() if "psi (axis-frame)" in line)
     assert "alignment: psi" in res.out and psi.split()[2][2:7] in res.out
+
+
+def test_allan_on_raw_gyro_counts_without_their_size_is_refused(run_cli):
+    """The MPU-6050 static record holds raw counts: read as deg/s its x gyro would sit at -428 deg/s, which no gyro
+    at rest reads (a user study found the figures accepted silently)."""
+    log = SHARED / "data/static/mpu6050_tomisuarez2/imu_static_test.csv"
+    res = run_cli("allan", log, "--skip-rows", "4", "--columns", "gx,gy,gz", "--rate-hz", "100")
+    assert res.code == 3 and "channel gx reads -428 deg/s" in res.err and "--gyro-units" in res.err
+    assert res.err.count("\n") == 1 and "Traceback" not in res.err
