@@ -88,7 +88,7 @@ def parse_mounting(table: dict, where: str) -> np.ndarray:
 
     ``axes = ["+y", "-x", "+z"]``: the system axis each gyro (x, y, z in order) points along; or
     ``matrix = [[...], [...], [...]]``: each gyro's nominal axis as a unit vector (rows) in the system frame,
-    orthonormal within 1e-3 (then made exactly orthonormal). A mirrored set (``det = -1``) is refused.
+    orthonormal within 5e-3 (then made exactly orthonormal). A mirrored set (``det = -1``) is refused.
     """
     check_keys(table, MOUNTING_KEYS, where)
     if ("axes" in table) == ("matrix" in table):
@@ -107,7 +107,7 @@ def parse_mounting(table: dict, where: str) -> np.ndarray:
             raise InputError("must be three rows of three numbers, e.g. [[0.866, 0.5, 0], [-0.5, 0.866, 0], [0, 0, 1]]",
                              here)
         off = float(np.abs(n @ n.T - np.eye(3)).max())
-        if off > 1e-3:
+        if off > 5e-3:  # rounded entries (0.866, 0.5) pass; the nearest rotation is then used
             raise InputError(f"the rows are not perpendicular unit vectors (N N^T differs from the identity by {off:.2g}); "
                              "give each gyro's nominal axis as a unit vector", here)
     if np.linalg.det(n) < 0:

@@ -230,10 +230,30 @@ def _refuse_unaligned(plan: Plan, cands: list[Candidate], where: str) -> None:
         c = 3 - a - b
         cols[:, c] = np.cross(cols[:, (c + 1) % 3], cols[:, (c + 2) % 3])
     n = nearest_rotation(cols)
-    rows = ", ".join("[" + ", ".join(f"{v:.3f}" for v in row) + "]" for row in n)
+    angle, axis, nominal = _round_rotation(n)
+    rows = ", ".join("[" + ", ".join(f"{v:.4f}" for v in row) + "]" for row in nominal)
     raise TestError(f"the turns are found but each moves several gyros: the IMU is mounted at an angle to the system "
-                    f"axes (measured: {mounting_label(n)}); declare its nominal mounting in the plan, e.g. "
-                    f"[mounting] matrix = [{rows}]", where)
+                    f"axes (measured: {mounting_label(n)}); declare its nominal mounting in the plan (the nearest round "
+                    f"rotation is {angle:g} deg about {axis}: check it against the drawing), e.g. [mounting] matrix = "
+                    f"[{rows}]", where)
+
+
+def _round_rotation(n: np.ndarray) -> tuple[float, str, np.ndarray]:
+    """The measured mounting ``n`` rounded to a nominal one: its rotation (``N = R^T``) to whole degrees about the
+    nearest system axis (within 3 deg) or an axis rounded to 0.1; returns (angle deg, axis text, ``N``)."""
+    from scipy.spatial.transform import Rotation
+
+    rotvec = Rotation.from_matrix(n.T).as_rotvec()
+    angle = float(np.linalg.norm(rotvec))
+    axis = rotvec / angle if angle > 0 else np.array([0.0, 0.0, 1.0])
+    j = int(np.argmax(np.abs(axis)))
+    if abs(axis[j]) > np.cos(3 * np.pi / 180):
+        axis, text = np.sign(axis[j]) * np.eye(3)[j], ("+" if axis[j] > 0 else "-") + "xyz"[j]
+    else:
+        axis = np.round(axis, 1) / np.linalg.norm(np.round(axis, 1))
+        text = "(" + ", ".join(f"{v:.2g}" for v in axis) + ")"
+    degrees = float(np.round(angle * 180 / np.pi))
+    return degrees, text, Rotation.from_rotvec(axis * degrees * np.pi / 180).as_matrix().T
 
 
 def _label(plan: Plan, k: int) -> str:

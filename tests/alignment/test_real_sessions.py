@@ -66,7 +66,7 @@ def test_signed_permutation_mounting_is_detected(mounting, seed):
     assert np.allclose(r.correct(sess.g[:5]), np.linalg.solve(model.M, (sess.g[:5] - r.bias).T).T, atol=2e-3)
 
 
-def test_arbitrary_rotation_is_refused_undeclared_and_measured_declared():
+def test_arbitrary_rotation_is_refused_undeclared_and_measured_declared(tmp_path):
     n = mounting_from_rotation(30 * DEG, [0, 0, 1])
     model = model_for(0, n)
     plan = Plan.standard_rate(RATE)
@@ -74,10 +74,18 @@ def test_arbitrary_rotation_is_refused_undeclared_and_measured_declared():
     with pytest.raises(TestError) as err:
         align(sess.t, sess.g, plan)
     line = str(err.value)
-    assert "mounted at an angle" in line and "[mounting] matrix = [[0.86" in line and "\n" not in line
-    declared = Plan(plan.steps, mounting=tuple(map(tuple, n)))
+    assert "mounted at an angle" in line and "30 deg about +z" in line and "\n" not in line
+    # the suggestion pasted into the plan reads back, and keeps the misalignment to measure (0.5 deg), not the
+    # measured matrix (which would hide it)
+    from align.io import read_toml
+
+    f = tmp_path / "plan.toml"
+    f.write_text(line.split("e.g. ", 1)[1].replace("[mounting] matrix", "[mounting]\nmatrix") + "\n" + plan.to_toml())
+    declared = Plan.from_dict(read_toml(f), str(f))
+    assert np.allclose(declared.nominal, n, atol=1e-4)
     r = align(sess.t, sess.g, declared)
-    assert r.mounting_source == "declared" and np.allclose(r.mounting, n)
+    assert r.mounting_source == "declared" and np.allclose(r.mounting, n, atol=1e-4)
+    assert 0.3 * DEG < np.max(r.angles.psi) < 1.5 * DEG
     judge(r, model, SPEC, sess)
 
 
