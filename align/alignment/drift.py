@@ -253,9 +253,10 @@ def estimate_drift(observations: list[Observation], t: np.ndarray, sigma: np.nda
     walk, flick = np.sqrt(walk2), np.sqrt(flick2)
     where = (f"{len(probes)} static periods" if source == "static periods"
              else f"the scatter of {len(probes)} pairwise biases of +/- pairs (no static periods; a rough estimate)")
-    note = (f"bias drift measured from {where}: random walk up to {to_unit(walk.max(), 'deg/h/sqrt(h)'):.3g} "
-            f"deg/h/sqrt(h), flicker up to {to_unit(flick.max(), 'deg/h'):.3g} deg/h; the bias change between "
-            "segments is in the uncertainties, and the bias is the mean over the segments used")
+    note = (f"bias drift allowed for, estimated from {where} (a rough figure from few periods, the largest of the "
+            f"gyros): random walk {to_unit(walk.max(), 'deg/h/sqrt(h)'):.3g} deg/h/sqrt(h), flicker "
+            f"{to_unit(flick.max(), 'deg/h'):.3g} deg/h; the bias change between segments is in the uncertainties, "
+            "and the bias is the mean over the segments used")
     return Drift(walk, flick, source, len(probes), note)
 
 

@@ -279,7 +279,9 @@ def _why(plan: Plan, k: int, cands: list[Candidate], pos: int, n: np.ndarray, de
         return (f"{said}, the next motion ({seen}) turned about another axis than {mount} expects; check the fixture "
                 "orientation, the step's axis or the plan's [mounting]")
     if along < 0:
-        return f"{said}, the next motion ({seen}) turned the wrong way; re-run the step or correct its sign in the plan"
+        also = " (or a sign of the plan's [mounting])" if declared else ""
+        return (f"{said}, the next motion ({seen}) turned the wrong way; re-run the step or correct its sign in the "
+                f"plan{also}")
     return (f"{said}, the next motion ({seen}) is off by {100 * (along / np.linalg.norm(e) - 1):+.1f} %: wrong table "
             "rate or angle, or a wrong plan step")
 

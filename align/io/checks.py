@@ -6,7 +6,7 @@ must have no gaps or jitter. Each refusal names the first bad data row.
 
 Public names
 ------------
-check_finite, check_readings, check_time, check_log, MAX_READING
+check_finite, check_readings, check_repeats, check_time, check_log, MAX_READING
 """
 
 from __future__ import annotations
@@ -50,12 +50,25 @@ def check_readings(x: np.ndarray, where: str, t: np.ndarray | None = None, first
                          f"{rows[0] + first_row}: {value:.3g}): not a sensor reading; remove or repair them", where)
 
 
+def check_repeats(t: np.ndarray, where: str) -> None:
+    """Refuse time stamps that repeat on more than a tenth of the steps (and never go back): a logger clock coarser
+    than the sample interval (integer milliseconds at 2 kHz), to be read at its sample rate instead."""
+    dt = np.diff(t)
+    repeats = int(np.sum(dt == 0))
+    if repeats > 0.1 * len(dt) and not np.any(dt < 0):
+        k = int(np.argmax(dt == 0))
+        raise InputError(f"time stamps repeat on {repeats} of {len(dt)} steps (first at data row {k + 2}, t={t[k]:.9g}): "
+                         "the clock is coarser than the sample interval; read the log without its time column at its "
+                         "sample rate ({rate_hz})", where)
+
+
 def check_time(t: np.ndarray, where: str, gap: float | None = None, jitter: bool = False) -> None:
     """Time must increase; with ``gap``, no step may exceed ``gap`` times the median step
     (and, with ``jitter``, none may fall below ``2 - gap`` times it: uniform sampling)."""
     dt = np.diff(t)
     if np.any(dt <= 0):
         k = int(np.argmax(dt <= 0))
+        check_repeats(t, where)
         raise InputError(f"time does not increase at data row {k + 2} (t={t[k + 1]:.9g} s after {t[k]:.9g} s); "
                          "sort the log or fix the time column", where)
     if gap is None or len(dt) == 0:

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from align.errors import InputError, UnitError, literal
-from align.io.checks import MAX_READING, check_finite, check_log, check_readings, check_time
+from align.io.checks import MAX_READING, check_finite, check_log, check_readings, check_repeats, check_time
 from align.io.files import existing_file
 from align.io.formats import TIME_UNITS, LogFormat, time_unit
 from align.io.tables import read_columns, shown
@@ -129,6 +129,7 @@ class SensorLog:
 
 def _time_of(raw: np.ndarray, column: str, where: str, fmt: LogFormat) -> tuple[np.ndarray, str, bool]:
     """Time in s from a time column's numbers; its unit detected or given (:func:`~align.io.formats.time_unit`)."""
+    check_repeats(raw, where)  # before the step is judged: a coarse clock's median step means nothing
     step = float(np.median(np.diff(raw))) if len(raw) > 1 else float("nan")
     unit, detected = time_unit(step, column, where, fmt.time_units, float(raw[0]) if len(raw) else None)
     return (raw * TIME_UNITS[unit] if unit != "s" else raw), unit, detected

@@ -293,3 +293,16 @@ def test_comments_and_blank_runs_keep_line_ends_and_drop_what_they_should(tmp_pa
     (tmp_path / "log.csv").write_bytes(text.encode())
     _, data = read_columns(tmp_path / "log.csv", ["t", "x"], log_format=LogFormat(comment="#"))
     np.testing.assert_array_equal(data, [[1, 2], [3, 4]])
+
+
+def test_a_clock_coarser_than_the_samples_points_to_the_sample_rate(tmp_path):
+    """Integer milliseconds at 2 kHz: every other stamp repeats; the fix is to read at the sample rate, not to sort."""
+    n = 4000
+    t_ms = np.floor(np.arange(n) / 2.0)  # 2 kHz, ms clock
+    f = tmp_path / "coarse.csv"
+    f.write_text("time,gyro_x,gyro_y,gyro_z\n" + "\n".join(f"{a:.0f},0.1,0.2,0.3" for a in t_ms) + "\n")
+    with pytest.raises(InputError, match="the clock is coarser than the sample interval") as err:
+        read_log(f, ["gyro_x", "gyro_y", "gyro_z"], "deg/s")
+    assert err.value.fields == ["rate_hz"]
+    t, _ = read_log(f, ["gyro_x", "gyro_y", "gyro_z"], "deg/s", time_column=None, rate_hz=2000.0)
+    assert t[-1] == pytest.approx((n - 1) / 2000.0)
