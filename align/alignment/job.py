@@ -30,7 +30,16 @@ from align.alignment.match import Candidate, match_steps
 from align.alignment.observe import EarthModel, observe
 from align.alignment.plan import Plan
 from align.alignment.result import AlignmentResult, SegmentReport
-from align.alignment.segment import Motion, Segment, Segmentation, SegmentOptions, integrate, noise_sigma, segment_log
+from align.alignment.segment import (
+    Motion,
+    Segment,
+    Segmentation,
+    SegmentOptions,
+    integrate,
+    moves_between,
+    noise_sigma,
+    segment_log,
+)
 from align.alignment.twoaxis import two_axis, two_axis_error_bound
 from align.earth import EARTH_RATE
 from align.errors import InputError, literal
@@ -104,8 +113,10 @@ def _choose(method: str, plan: Plan, missing: int | None) -> str:
     return method
 
 
-def _explicit(t: np.ndarray, g: np.ndarray, plan: Plan, segments: list[Segment], where: str) -> Segmentation:
-    """The mounting for explicit segments: the plan's, or the one their steps' readings fit (as for found ones)."""
+def _explicit(t: np.ndarray, g: np.ndarray, plan: Plan, segments: list[Segment], sigma: np.ndarray,
+              where: str) -> Segmentation:
+    """The mounting for explicit segments (the plan's, or the one their steps' readings fit, as for found ones) and
+    the motions between their static periods that no step holds (after one, a rest orientation is unknown)."""
     statics = [s for s in segments if s.kind == "static"]
     bias = (np.sum([g[s.start:s.end].sum(axis=0) for s in statics], axis=0) / sum(s.n for s in statics)
             if statics else np.zeros(3))
@@ -119,7 +130,7 @@ def _explicit(t: np.ndarray, g: np.ndarray, plan: Plan, segments: list[Segment],
     names = {(s.start, s.end): s.name for s in segments}
     match = match_steps(plan, cands, lambda c: f"segment '{literal(names[c.start, c.end])}', samples {c.start}-{c.end}",
                         where)
-    return Segmentation(tuple(segments), (), match.mounting, match.source)
+    return Segmentation(tuple(segments), tuple(moves_between(t, g, segments, sigma)), match.mounting, match.source)
 
 
 def _motions(t: np.ndarray, unclaimed, a: np.ndarray) -> tuple[Motion, ...]:
@@ -183,7 +194,7 @@ def align(
     fs = 1.0 / float(np.median(np.diff(t)))
     sigma = noise_sigma(g)
     found = (segment_log(t, g, plan, options.segmentation, where, sigma) if segments is None
-             else _explicit(t, g, plan, list(segments), where))
+             else _explicit(t, g, plan, list(segments), sigma, where))
     segments, nominal = list(found.segments), found.mounting
     checks = [check_durations(segments, fs, options.min_dwell),
               check_saturation(g, segments, options.gyro_range, units)]

@@ -9,8 +9,8 @@ plateaus. Everything here works on SI arrays and never reads files.
 
 Public names
 ------------
-Segment, Motion, Segmentation, SegmentOptions, noise_sigma, find_plateaus, integrate, segment_log,
-segments_from_ranges, true_runs
+Segment, Motion, Segmentation, SegmentOptions, noise_sigma, find_plateaus, integrate, segment_log, moves_between,
+untaken, segments_from_ranges, true_runs
 """
 
 from __future__ import annotations
@@ -339,9 +339,20 @@ def segment_log(
     unclaimed = list(match.unclaimed)
     if plan.kind == "rate":  # the moves between rests that hold no dwell at all (fixture re-orientations)
         taken = [(s.start, s.end) for s in segs if s.kind == "rate"] + [(c.start, c.end) for c in unclaimed]
-        unclaimed += [c for c in turns if not any(a < c.end and c.start < b for a, b in taken)]
+        unclaimed += untaken(turns, taken)
     unclaimed.sort(key=lambda c: c.start)
     return Segmentation(tuple(segs), tuple(unclaimed), match.mounting, match.source)
+
+
+def untaken(turns: list[Candidate], taken: list[tuple[int, int]]) -> list[Candidate]:
+    """The turns between rests that overlap none of the ``taken`` sample ranges: motions no step holds."""
+    return [c for c in turns if not any(a < c.end and c.start < b for a, b in taken)]
+
+
+def moves_between(t: np.ndarray, g: np.ndarray, segments: list[Segment], sigma: np.ndarray) -> list[Candidate]:
+    """Motions between the static periods of explicit ``segments`` that no step segment holds (fixture moves)."""
+    statics = sorted((s.start, s.end) for s in segments if s.kind == "static")
+    return untaken(_turns(t, g, statics, sigma, head=False), [(s.start, s.end) for s in segments if s.step is not None])
 
 
 #: the keys of one range of an explicit segments file

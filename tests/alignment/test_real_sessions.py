@@ -237,3 +237,30 @@ def test_the_reoriented_example_is_found_and_covered(run_cli, tmp_path):
     assert len(r["motions"]) == len(truth["moves"]) == 2
     assert r["inputs"]["time_units"] == "ms"
     assert (tmp_path / "seg.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_explicit_segments_with_rest_orientations_and_fixture_moves():
+    """Explicit segments (from the simulator's own pieces): the moves between them are found, so a static period
+    before a move is not modelled with the next step's rest (review of issue 12: residuals of 20 deg/h)."""
+    from align.alignment.segment import Segment
+
+    lat = 48.1 * DEG
+    rests = {0: ("up", "south", "east"), 1: ("east", "up", "south"), 2: ("north", "west", "up")}
+    steps = tuple(Step(s.axis, s.sign, angle=s.angle, rest=rests[s.axis]) for s in Plan.standard_angle(360 * DEG).steps)
+    plan = Plan(steps, latitude=lat)
+    model = model_for(3)
+    spec = SessionSpec(noise_density=0.002 * DEG_S, static_s=10.0, reorient=True)
+    sess = simulate_run(plan, model, spec, 3)
+    segs, k = [], 0
+    for p in sess.pieces:
+        if p.kind == "static" and p.end - p.start > 200:
+            segs.append(Segment(f"static {len(segs)}", "static", p.start + 100, p.end - 100))
+        elif p.kind == "step":
+            segs.append(Segment(f"step {p.step + 1}", "angle", p.start - 20, p.end + 20, p.step))
+    r = align(sess.t, sess.g, plan, segments=segs)
+    assert len(r.motions) == len(sess.moves) == 2
+    note = next(n for n in r.notes if n.startswith("Earth rate at latitude"))
+    whole = int(note.split("the whole vector in ")[1].split()[0])
+    assert whole == sum(1 for s in segs if s.kind == "static") - 2 - 1  # not before a move, nor the last one
+    assert np.all(np.abs(r.bias - model.bias) < 3 * r.sigma_bias)
+    assert np.all(np.abs(r.M - model.M) < 3 * r.sigma_M)
