@@ -10,13 +10,14 @@ uT: 1/100), the refusal names the mix-up and the fix as a placeholder
 calibration measures. A matrix that is to correct a log must be finite,
 invertible and right-handed (``det > 0``, reference section 1); an
 accelerometer calibrated from known orientations must read each axis on that
-axis (a flipped axis or swapped positions is a handedness error).
+axis (a flipped axis or swapped positions is a handedness error). Whether a
+result file is well formed is :mod:`align.wellformed`.
 
 Public names
 ------------
 check_gravity, check_at_rest, check_static_rates, check_field_strength, check_known_field, check_corrected, check_dip, check_axes,
 check_scale_factors, scale_outside,
-check_usable_model, check_positive_definite, require_finite, array_field, malformed, mixup_hint,
+check_usable_model, check_positive_definite, mixup_hint,
 ACCELERATION_UNITS, FIELD_UNITS, GRAVITY_RANGE, EARTH_FIELD, FIELD_RANGE, AT_REST_RANGE, MAX_CONDITION
 """
 
@@ -359,52 +360,6 @@ def scale_outside(m: np.ndarray, tolerance: float) -> tuple[int, float] | None:
         if not abs(s - 1.0) <= tolerance:
             return i, float(s)
     return None
-
-
-def require_finite(where: str, what: str, **arrays: np.ndarray | None) -> None:
-    """Refuse a result whose named arrays hold null, NaN or infinite values (a malformed file).
-
-    Parameters
-    ----------
-    where : str
-        The file (and sensor).
-    what : str
-        The kind of result, e.g. ``"alignment result"``.
-    **arrays : ndarray or None
-        Name -> array; None is skipped.
-    """
-    for name, a in arrays.items():
-        if a is not None and not np.all(np.isfinite(np.asarray(a, float))):
-            raise InputError(f"malformed {what}: {name} holds null or non-finite values; regenerate the result", where)
-
-
-def array_field(d: dict, key: str, shape: tuple[int, ...], what: str, where: str, factor: float = 1.0) -> np.ndarray:
-    """A finite array of ``shape`` read from a result file's ``d[key]`` (times ``factor``), or a one-line refusal.
-
-    Raises
-    ------
-    InputError
-        ``alignment.json: malformed alignment result: M must be a 3x3 array of numbers`` (missing, text, wrong
-        shape) or ``...: M holds null or non-finite values; regenerate the result``.
-    """
-    size = "x".join(map(str, shape)) if len(shape) > 1 else f"{shape[0]}-element"
-    if key not in d:
-        raise InputError(f"malformed {what}: missing key '{key}'; regenerate the result", where)
-    try:
-        a = np.array(d[key], dtype=float) * factor
-        if a.shape != shape:
-            raise ValueError
-    except (TypeError, ValueError):
-        raise InputError(f"malformed {what}: {key} must be a {size} array of numbers; regenerate the result", where) from None
-    require_finite(where, what, **{key: a})
-    return a
-
-
-def malformed(exc: Exception) -> str:
-    """What a KeyError, TypeError or ValueError met while reading a result file says, without Python reprs."""
-    if isinstance(exc, KeyError):
-        return f"missing key {literal(repr(exc.args[0]) if exc.args else '')}"
-    return literal(" ".join(str(exc).split()) or type(exc).__name__)
 
 
 def check_usable_model(m: np.ndarray, where: str | None = None, name: str = "M") -> None:

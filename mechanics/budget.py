@@ -27,9 +27,9 @@ import numpy as np
 
 from align import CONVENTION
 from align.errors import InputError
-from align.plausible import malformed
 from align.results import Result
 from align.units import DEG
+from align.wellformed import malformed
 from mechanics.assembly import skew_limit, worst_case_per_axis
 from mechanics.formulas import rss, screw_radius, skew_from_screws, tilt_from_ledges
 from mechanics.montecarlo import MonteCarlo

@@ -18,10 +18,10 @@ from align.alignment.segment import Motion
 from align.errors import InputError
 from align.io import c_header
 from align.model import Angles, SensorModel, angles
-from align.plausible import array_field, malformed
 from align.results import Result, file_unit
 from align.units import DEG, parse_unit, to_unit
 from align.values import Value
+from align.wellformed import array_field, malformed
 
 FORMAT = "imu-align.alignment"
 FORMAT_VERSION = 1

@@ -38,10 +38,10 @@ from align.alignment.timeline import Move, build_timeline
 from align.errors import InputError
 from align.flicker import flicker_fft, flicker_gm
 from align.model import SensorModel
-from align.plausible import malformed
 from align.results import Result, file_unit
 from align.units import DEG, DEG_S, format_quantity, to_unit
 from align.values import Value
+from align.wellformed import malformed
 
 
 @dataclass(frozen=True)

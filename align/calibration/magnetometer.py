@@ -31,16 +31,10 @@ import numpy as np
 from align.calibration.ellipsoid import MODELS, algebraic_fit, pack, unpack
 from align.errors import InputError, TestError, literal
 from align.io import check_finite
-from align.plausible import (
-    array_field,
-    check_dip,
-    check_field_strength,
-    check_known_field,
-    check_positive_definite,
-    malformed,
-)
+from align.plausible import check_dip, check_field_strength, check_known_field, check_positive_definite
 from align.results import Result, file_unit
 from align.units import DEG, to_unit
+from align.wellformed import array_field, malformed
 
 FORMAT = "imu-align.magnetometer"
 CONVENTION = "m_cal = soft_iron (m_raw - hard_iron)"

@@ -22,10 +22,11 @@ import numpy as np
 from align.errors import InputError
 from align.io.export import imucal_dict
 from align.io.keys import check_keys
-from align.plausible import array_field, check_usable_model, malformed
+from align.plausible import check_usable_model
 from align.results import Result, file_unit
 from align.units import to_unit
 from align.values import Value, frozen_array
+from align.wellformed import array_field, malformed
 
 FORMAT = "imu-align.calibration"
 CONVENTION = "raw = M true + bias; true = M^-1 (raw - bias); rows of M are sensor axes"

@@ -24,9 +24,10 @@ from align.noise.allan import NOISE_ALPHA, AllanResult, allan, edf_overlapping
 from align.noise.fit import NoiseFit, fit_noise
 from align.noise.model import TERMS, avar_design
 from align.noise.planner import PlanResult, make_plan
-from align.plausible import check_static_rates, malformed
+from align.plausible import check_static_rates
 from align.results import Result, file_unit
 from align.units import DIMENSIONS, parse_unit, to_unit
+from align.wellformed import malformed
 
 FORMAT = "imu-align.allan"
 CONVENTION = ("overlapping Allan deviation (IEEE Std 1139, NIST SP 1065); noise model "

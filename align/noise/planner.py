@@ -24,10 +24,10 @@ import numpy as np
 from align.errors import InputError
 from align.noise.model import NoiseModel
 from align.parts import Part
-from align.plausible import malformed
 from align.results import Result
 from align.units import DEG, DEG_H
 from align.values import Value
+from align.wellformed import malformed
 
 FORMAT = "imu-align.plan"
 CONVENTION = ("noise target = rate sin(accuracy) / noise_ratio (Example 3); averaging time: "

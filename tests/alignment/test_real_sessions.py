@@ -251,7 +251,7 @@ def test_explicit_segments_with_rest_orientations_and_fixture_moves():
     model = model_for(3)
     spec = SessionSpec(noise_density=0.002 * DEG_S, static_s=10.0, reorient=True)
     sess = simulate_run(plan, model, spec, 3)
-    segs, k = [], 0
+    segs = []
     for p in sess.pieces:
         if p.kind == "static" and p.end - p.start > 200:
             segs.append(Segment(f"static {len(segs)}", "static", p.start + 100, p.end - 100))

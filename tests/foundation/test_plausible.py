@@ -19,9 +19,9 @@ from align.plausible import (
     check_scale_factors,
     check_usable_model,
     mixup_hint,
-    require_finite,
 )
 from align.units import DEG, STANDARD_GRAVITY
+from align.wellformed import require_finite
 
 G = STANDARD_GRAVITY
 
