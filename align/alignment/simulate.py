@@ -345,6 +345,9 @@ class SimulationTruth(Result, format="imu-align.truth", convention=CONVENTION):
         The nominal mounting ``N`` simulated (``M N^T`` is the small part), None when not recorded.
     moves : tuple of Move
         The re-orientation moves in the log.
+    bias_mean : ndarray, shape (3,), or None
+        Mean of the true bias path over the session, rad/s: what an alignment's bias estimates when the bias
+        drifts (``bias`` is the turn-on value).
     """
 
     model: SensorModel
@@ -353,17 +356,19 @@ class SimulationTruth(Result, format="imu-align.truth", convention=CONVENTION):
     inputs: dict = field(default_factory=dict)
     mounting: np.ndarray | None = None
     moves: tuple[Move, ...] = ()
+    bias_mean: np.ndarray | None = None
 
     def to_dict(self) -> dict:
         units = {"M": "1", "bias": self.units, "move_angle": "deg", "move_rate": "deg/s"}
         return {**self.envelope(units), "M": self.model.M.tolist(),
                 "A": self.model.alignment().tolist(), "bias": to_unit(self.model.bias, self.units).tolist(),
                 "mounting": None if self.mounting is None else self.mounting.tolist(),
-                "moves": [m.to_dict() for m in self.moves], "seed": self.seed, "inputs": self.inputs}
+                "moves": [m.to_dict() for m in self.moves], "seed": self.seed, "inputs": self.inputs,
+                "bias_mean": None if self.bias_mean is None else to_unit(self.bias_mean, self.units).tolist()}
 
     @classmethod
     def from_dict(cls, d: dict, where: str = "truth") -> SimulationTruth:
-        cls.check_envelope(d, where, keys=["M", "A", "bias", "mounting", "moves", "seed", "inputs"])
+        cls.check_envelope(d, where, keys=["M", "A", "bias", "mounting", "moves", "seed", "inputs", "bias_mean"])
         try:
             u, f = file_unit(d, "bias", "angular_rate", where)
             mounting = d.get("mounting")
@@ -373,6 +378,6 @@ class SimulationTruth(Result, format="imu-align.truth", convention=CONVENTION):
                 moves = [Move.from_dict(m, fa, fr) for m in moves]
             return cls(SensorModel(np.array(d["M"], float), np.array(d["bias"], float) * f), u, d.get("seed"),
                        dict(d.get("inputs", {})), None if mounting is None else _rotation(mounting, where),
-                       tuple(moves))
+                       tuple(moves), None if d.get("bias_mean") is None else np.array(d["bias_mean"], float) * f)
         except (KeyError, TypeError, ValueError) as exc:
             raise InputError(f"malformed simulation truth ({malformed(exc)}); regenerate it", where) from None

@@ -208,7 +208,7 @@ def simulate(
                       np.column_stack([np.arange(len(run.t)) * (TIME_UNITS[unit] / run.fs), to_unit(run.g, gyro_units)]))
         out.write_text(out_dir / names[1], the_plan.to_toml())
         out.write_json(out_dir / names[2], SimulationTruth(truth, gyro_units, seed, {"time_units": unit}, nominal,
-                                                           run.moves))
+                                                           run.moves, run.bias.mean(axis=0)))
     moves = f", {len(run.moves)} re-orientation moves" if run.moves else ""
     typer.echo(f"wrote {out_dir}/session.csv ({len(run.t)} rows, {run.t[-1]:.1f} s{moves}), plan.toml and truth.json")
 
