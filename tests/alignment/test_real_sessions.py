@@ -154,14 +154,18 @@ def test_angle_plan_with_latitude_models_the_static_periods(seed):
     assert next(c for c in r.checks if c.name == "residuals").status == "pass"  # no false "bias drift" warning
 
 
-def test_rest_orientation_models_the_whole_vector_in_static_periods():
-    lat = 48.1 * DEG
+def rested_session():
+    """An angle plan at latitude 48.1 deg with a stated rest orientation per axis and the fixture moved between axes."""
     rests = {0: ("up", "south", "east"), 1: ("east", "up", "south"), 2: ("north", "west", "up")}
     steps = tuple(Step(s.axis, s.sign, angle=s.angle, rest=rests[s.axis]) for s in Plan.standard_angle(360 * DEG).steps)
-    plan = Plan(steps, latitude=lat)
+    plan = Plan(steps, latitude=48.1 * DEG)
     model = model_for(3)
     spec = SessionSpec(noise_density=0.002 * DEG_S, static_s=10.0, reorient=True)
-    sess = simulate_run(plan, model, spec, 3)
+    return plan, model, simulate_run(plan, model, spec, 3)
+
+
+def test_rest_orientation_models_the_whole_vector_in_static_periods():
+    plan, model, sess = rested_session()
     r = align(sess.t, sess.g, plan)
     note = next(n for n in r.notes if n.startswith("Earth rate at latitude"))
     assert "the whole vector in" in note
@@ -244,13 +248,7 @@ def test_explicit_segments_with_rest_orientations_and_fixture_moves():
     before a move is not modelled with the next step's rest (review of issue 12: residuals of 20 deg/h)."""
     from align.alignment.segment import Segment
 
-    lat = 48.1 * DEG
-    rests = {0: ("up", "south", "east"), 1: ("east", "up", "south"), 2: ("north", "west", "up")}
-    steps = tuple(Step(s.axis, s.sign, angle=s.angle, rest=rests[s.axis]) for s in Plan.standard_angle(360 * DEG).steps)
-    plan = Plan(steps, latitude=lat)
-    model = model_for(3)
-    spec = SessionSpec(noise_density=0.002 * DEG_S, static_s=10.0, reorient=True)
-    sess = simulate_run(plan, model, spec, 3)
+    plan, model, sess = rested_session()
     segs = []
     for p in sess.pieces:
         if p.kind == "static" and p.end - p.start > 200:
