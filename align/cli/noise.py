@@ -40,7 +40,8 @@ Rate = "Table rate, e.g. '100 deg/s'"
 
 def allan(
     logs: Annotated[list[Path], typer.Argument(metavar="LOG...", show_default=False, help=(
-        "Static recordings: .csv, .csv.gz, .npy or raw float64 .bin; several runs give the bias repeatability."))],
+        "Static recordings: .csv, .csv.gz, .npy or raw float64 .bin; several runs are pooled (each run's curve "
+        "and fit, a pooled curve fitted and planned from) and give the bias repeatability."))],
     columns: opt.Columns("Data columns (a CSV's time column is 'time' unless --rate-hz).") = "gyro_x,gyro_y,gyro_z",
     rate_hz: opt.RateHz("Sample rate, for files without a time column (.npy always).") = None,
     gyro_units: opt.GyroUnits("Unit of the data columns (an angular rate).") = "deg/s",
@@ -76,7 +77,7 @@ def allan(
     unit, scale = _allan_unit(gyro_units, units)
     channels = names(columns)
     runs, fs = read_runs(logs, channels, rate_hz, fmt, scale)
-    with progress(runs[0].shape[0], "Allan deviation (samples read)") as tick:
+    with progress(sum(r.shape[0] for r in runs), "Allan deviation (samples read)") as tick:
         job = run_allan(runs, fs, channels, unit, grid, per_decade, modified, progress=tick,
                         memory_limit=memory_limit_mb * 1e6, where=[str(p) for p in logs])
     job = job.replace(inputs=tuple(str(p) for p in logs))

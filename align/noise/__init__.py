@@ -2,12 +2,17 @@
 
 Modules
 -------
-model     the IEEE Std 952 five-term Allan-variance model (one place): TERMS, NoiseModel, model_adev
+model     the IEEE Std 952 five-term Allan-variance model (one place) and TERM_TABLE, the names of its terms
 allan     overlapping / modified Allan deviation of many channels, confidence intervals (numba kernels in _kernels)
-fit       whole-model noise fit, IEEE point readouts, the seed's noise figures
+identify  per-tau noise identification (lag-1 autocorrelation, B1 ratio) and the EDF that follows
+covariance covariance of overlapping Allan variances of a noise model (the fit's weights)
+fit       whole-model noise fit (generalised least squares), upper bounds, the seed's noise figures
+gls       generalised least squares of the Allan variance on the model, with profile intervals (the fit's core)
+readouts  IEEE point readouts (N at tau = 1 s, floor, K at tau = 3 s) with their intervals
 sim       sensor-error simulator and the seed's three error models
 planner   averaging time and test plan (reference Example 3); result ``imu-align.plan``
-job       the Allan job (logs -> deviation, fits, figures); result ``imu-align.allan``
+job       the Allan job (logs -> deviation of every run, pooled curve, fits, figures); result ``imu-align.allan``
+jobfile   the JSON form of the job's curves and fits (engineering units, the names of TERM_TABLE)
 
 The plot of an Allan job is :func:`align.present.plots.allan_plot_png` (this
 family draws nothing). Note that ``align.noise.allan`` as an attribute of this
@@ -16,18 +21,29 @@ other names with ``from align.noise.allan import ...`` (or from here).
 
 Public names
 ------------
-TERMS, NOISE_ALPHA, FLICKER_FACTOR, NoiseModel, avar_design, model_avar, model_adev (model);
+TERMS, Term, TERM_TABLE, term, NOISE_ALPHA, FLICKER_FACTOR, NoiseModel, avar_design, model_avar, model_adev (model);
 tau_grid, AllanResult, allan, ArrayChunks, window_stability, edf_overlapping, confidence_interval (allan);
 NoiseFit, fit_noise, point_readouts, noise_figures, nnls_small (fit);
 NoiseSpec, FLICKER_MODELS, simulate_noise, simulate_imu, seed_method_a, seed_method_b, seed_restoring (sim);
 PlanResult, Averaging, noise_target, model_curve, averaging_time, longest_turn, make_plan (planner);
-AllanJob, run_allan, read_runs, plan_from_allan, term_units (job)
+AllanJob, run_allan, pool_runs, read_runs, plan_from_allan, term_units (job)
 """
 
 from align.noise.allan import AllanResult, ArrayChunks, allan, confidence_interval, edf_overlapping, tau_grid, window_stability
 from align.noise.fit import NoiseFit, fit_noise, nnls_small, noise_figures, point_readouts
-from align.noise.job import AllanJob, plan_from_allan, read_runs, run_allan, term_units
-from align.noise.model import FLICKER_FACTOR, NOISE_ALPHA, TERMS, NoiseModel, avar_design, model_adev, model_avar
+from align.noise.job import AllanJob, plan_from_allan, pool_runs, read_runs, run_allan, term_units
+from align.noise.model import (
+    FLICKER_FACTOR,
+    NOISE_ALPHA,
+    TERM_TABLE,
+    TERMS,
+    NoiseModel,
+    Term,
+    avar_design,
+    model_adev,
+    model_avar,
+    term,
+)
 from align.noise.planner import (
                                Averaging,
                                PlanResult,
@@ -41,10 +57,11 @@ from align.noise.planner import (
 from align.noise.sim import FLICKER_MODELS, NoiseSpec, seed_method_a, seed_method_b, seed_restoring, simulate_imu, simulate_noise
 
 __all__ = [
-    "FLICKER_FACTOR", "NOISE_ALPHA", "TERMS", "NoiseModel", "avar_design", "model_adev", "model_avar",
+    "FLICKER_FACTOR", "NOISE_ALPHA", "TERMS", "Term", "TERM_TABLE", "term", "NoiseModel",
+    "avar_design", "model_adev", "model_avar",
     "AllanResult", "ArrayChunks", "allan", "confidence_interval", "edf_overlapping", "tau_grid", "window_stability",
     "NoiseFit", "fit_noise", "nnls_small", "noise_figures", "point_readouts",
     "FLICKER_MODELS", "NoiseSpec", "seed_method_a", "seed_method_b", "seed_restoring", "simulate_imu", "simulate_noise",
     "Averaging", "PlanResult", "averaging_time", "longest_turn", "make_plan", "model_curve", "noise_target", "preset_model",
-    "AllanJob", "plan_from_allan", "read_runs", "run_allan", "term_units",
+    "AllanJob", "plan_from_allan", "pool_runs", "read_runs", "run_allan", "term_units",
 ]

@@ -12,9 +12,12 @@ with no temporaries the size of the record; the phase is built in place, and a r
 larger than ``memory_limit`` bytes keeps its phase in a temporary file
 (``numpy.memmap``), so 1e8-sample recordings run in bounded memory.
 
-Confidence intervals use the equivalent degrees of freedom of Howe's simple
-formulas for the overlapping estimator (NIST SP 1065 Table 5) with the noise
-type dominant at each tau, and chi-square quantiles.
+Every point carries the noise type identified from the data at its tau (lag-1
+autocorrelation, B1 ratio; :mod:`align.noise.identify`, NIST SP 1065 section 5.6),
+its equivalent degrees of freedom from that type (Greenhall & Riley 2003, as
+Stable32) and so its chi-square confidence interval (SP 1065 section 5.3,
+:meth:`AllanResult.interval`). Howe's simple EDF formulas (SP 1065 Table 5) stay
+available as :func:`edf_overlapping`.
 
 Public names
 ------------
@@ -225,6 +228,14 @@ class AllanResult(Value):
         Mean of each channel (seed 002 Eq 5).
     stability : dict
         Period (s) -> ndarray (C,): bias stability (seed 002 Eq 7).
+    alpha : ndarray of int or None, shape (C, T)
+        Noise type identified at each tau: exponent of the rate PSD ``S ~ f^alpha``, 2 white PM /
+        quantization, 1 flicker PM, 0 white FM / angle random walk, -1 flicker FM / bias instability,
+        -2 random-walk FM / rate random walk (:func:`align.noise.identify.noise_type_name`).
+    edf : ndarray or None, shape (C, T)
+        Equivalent degrees of freedom of each ``adev`` point (Greenhall, from ``alpha``).
+    edf_mdev : ndarray or None, shape (C, T)
+        The same for ``mdev`` (NaN where ``mdev`` is).
 
     Arrays (also those of ``stability``) are read-only copies; ``==`` compares by value.
     """
@@ -238,6 +249,9 @@ class AllanResult(Value):
     names: tuple
     bias: np.ndarray | None = None
     stability: dict | None = None
+    alpha: np.ndarray | None = None
+    edf: np.ndarray | None = None
+    edf_mdev: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -253,6 +267,27 @@ class AllanResult(Value):
     @property
     def n_phase(self) -> int:
         return self.n + 1
+
+    def interval(self, level: float = 0.682689492137086, modified: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """Chi-square confidence interval of every point (NIST SP 1065 section 5.3.3).
+
+        Parameters
+        ----------
+        level : float
+            Probability that the interval holds the true deviation (0.6827: 1 sigma).
+        modified : bool
+            Of ``mdev`` instead of ``adev``.
+
+        Returns
+        -------
+        lo, hi : ndarray, shape (C, T)
+            In the unit of the deviations.
+        """
+        dev, edf = (self.mdev, self.edf_mdev) if modified else (self.adev, self.edf)
+        if dev is None or edf is None:
+            raise ValueError(f"this result has no {'mdev' if modified else 'adev'} EDF "
+                             "(made without noise identification)")
+        return confidence_interval(dev, edf, level)
 
     def scaled(self, factor: float) -> AllanResult:
         """The same result with the data unit scaled by ``factor`` (deviations are linear in it)."""
@@ -311,6 +346,29 @@ def allan(data, fs: float, names=None, grid="dense", per_decade: int = 10, modif
         mdev = np.full((c, len(m)), np.nan)
         mm = m[3 * m <= n + 1]
         mdev[:, : len(mm)] = np.sqrt(mvar_sums(x, mm) / (2.0 * mm.astype(float) ** 2 * (mm / fs) ** 2 * (n + 1 - 3 * mm + 1)))
+    alpha = edf = edf_m = None
+    if deviations:
+        alpha, edf, edf_m = _identified(x, m, adev, mdev, fs, mvar_sums)
     stability = {p: np.array([window_stability(x[j], fs, p) for j in range(c)]) for p in periods}
     del x
-    return AllanResult(tau, m, adev, mdev, n, fs, names, means, stability)
+    return AllanResult(tau, m, adev, mdev, n, fs, names, means, stability, alpha, edf, edf_m)
+
+
+def _identified(x, m, adev, mdev, fs, mvar_sums) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """Noise type of every point and the Greenhall EDF of ``adev`` (and ``mdev``) that follows."""
+    from align.noise.identify import edf_of, identify_noise
+
+    n_phase = x.shape[1]
+
+    def mvar_of(k: int) -> np.ndarray:  # only where the B1 ratio finds phase noise
+        if mdev is not None and np.all(np.isfinite(mdev[:, k])):
+            return mdev[:, k] ** 2
+        mk = m[k : k + 1]
+        return mvar_sums(x, mk)[:, 0] / (2.0 * float(mk[0]) ** 2 * (mk[0] / fs) ** 2 * (n_phase - 3 * mk[0] + 1))
+
+    alpha, _ = identify_noise(x, m, adev**2, mvar_of)
+    edf = edf_of(alpha, m, n_phase)
+    edf_m = None
+    if mdev is not None:
+        edf_m = np.where(np.isfinite(mdev), edf_of(alpha, m, n_phase, modified=True), np.nan)
+    return alpha, edf, edf_m

@@ -1,36 +1,63 @@
-"""Whole-model noise fit of an Allan variance curve, IEEE point readouts, noise figures.
+"""Whole-model noise fit of an Allan variance curve by generalised least squares, and noise figures.
 
-The five-term model of :mod:`align.noise.model` (IEEE Std 952 / 1554, reference
-section 6)::
+The five-term model of :mod:`align.noise.model` (IEEE Std 952 Annex C / Std 1554)::
 
-    sigma^2(tau) = 3 Q^2 / tau^2 + N^2 / tau + (2 ln 2 / pi) B^2 + K^2 tau / 3 + R^2 tau^2 / 2
+    sigma^2(tau) = 3 Q^2 / tau^2 + N^2 / tau + (2 ln 2 / pi) B^2 + K^2 tau / 3 + R^2 tau^2 / 2  =  A(tau) p
 
-quantization ``Q``, angle (velocity) random walk ``N``, bias instability ``B``
-(curve floor ``0.664 B``), rate random walk ``K``, rate ramp ``R``. The squared
-parameters are found by weighted non-negative least squares on the Allan
-variance (weights from each point's equivalent degrees of freedom), refitted
-once with the noise type the first fit makes dominant at each tau. The IEEE
-point readouts (the tau = 1 s line, floor / 0.664, the tau = 3 s line) are kept
-beside it, labelled as such.
+is linear in the squared parameters ``p = (Q^2, N^2, B^2, K^2, R^2)``. Overlapping Allan variances
+at neighbouring taus share most of their data and are strongly correlated (0.7-0.9 between
+neighbours of a dense grid), so the fit is generalised least squares (:mod:`align.noise.gls`) with
+their full covariance ``S(p)`` computed analytically from the fitted model itself
+(:mod:`align.noise.covariance`, exact for Gaussian power-law noise; no bootstrap, no independence
+assumption): non-negative ``p`` minimising ``(y - A p)' S(p)^-1 (y - A p)`` over at most
+:data:`FIT_POINTS` log-spaced points of the curve, ``S`` recomputed from the fit :data:`ITERATIONS`
+times, a term kept only when it lowers the chi-square by 4 or more. The covariance of ``p`` is
+``(A' S^-1 A)^-1`` on the kept terms, scaled by ``chi2 / dof`` when above 1 (a curve the model does
+not describe), and a parameter's 1-sigma is ``sigma(p_k) / (2 sqrt(p_k))``.
+
+A term is identifiable when it is positive, at least 30 % of the model at some fitted tau, and
+known to 25 % (1-sigma). Otherwise the fit gives its one-sided 95 % upper bound (the largest value
+whose curve alone stays under every point's one-sided 99 % chi-square
+bound ``AVAR edf / chi2_0.01(edf)``, NIST SP 1065 Eq 5.34, about 95 % over the points: at the long-tau end for K and R) and the
+record length (sample rate for ``Q`` and ``N``) at which a term of that size would be identifiable
+by the same test, from the Fisher information ``A' S^-1 A`` of such a record. The IEEE point
+readouts (:mod:`align.noise.readouts`) are kept beside the fit, labelled as such. SI throughout.
 
 Public names
 ------------
-NoiseFit, fit_noise, point_readouts, noise_figures, nnls_small;
+NoiseFit, fit_noise, point_readouts, noise_figures, nnls_small, FIT_METHOD;
 TERMS, model_adev (from :mod:`align.noise.model`)
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from align.errors import TestError
-from align.noise.allan import AllanResult, confidence_interval, edf_overlapping
-from align.noise.model import FLICKER_FACTOR, NOISE_ALPHA, TERMS, NoiseModel, avar_design, model_adev
+from align.noise.allan import AllanResult, confidence_interval, edf_overlapping, tau_grid
+from align.noise.covariance import avar_covariance, avar_covariance_basis
+from align.noise.gls import GlsFit, nnls_small, scaled_nnls, whitener
+from align.noise.model import NOISE_ALPHA, TERMS, NoiseModel, avar_design, model_adev
+from align.noise.readouts import point_readouts
 from align.values import Value
 
-__all__ = ["NoiseFit", "fit_noise", "point_readouts", "noise_figures", "nnls_small", "TERMS", "model_adev"]
+__all__ = ["NoiseFit", "fit_noise", "point_readouts", "noise_figures", "nnls_small", "FIT_METHOD", "TERMS",
+           "model_adev"]
+
+FIT_METHOD = ("generalised least squares on the overlapping Allan variance with its covariance from the fitted "
+              "model (IEEE 952 five-term model, non-negative squared terms)")
+#: most curve points the fit uses (log-spaced, the longest tau always among them)
+FIT_POINTS = 16
+#: refits with the covariance of the previous fit
+ITERATIONS = 3
+#: one-sided level of the upper bounds of terms that are not identifiable
+UPPER_LEVEL = 0.95
+#: one-sided level of each point's bound behind them (the minimum over several points: about 95 % overall)
+POINT_LEVEL = 0.99
+#: the IEEE letter of each term
+LETTERS = dict(zip(TERMS, "QNBKR"))
 
 
 @dataclass(frozen=True, eq=False)
@@ -40,20 +67,29 @@ class NoiseFit(Value):
     Attributes
     ----------
     params, sigma : ndarray, shape (5,)
-        ``Q, N, B, K, R`` and their 1-sigma (first-order from the NNLS covariance,
-        scaled by the fit's chi-square per degree of freedom when above 1;
-        neighbouring overlapping points are correlated, so take them as indicative).
+        ``Q, N, B, K, R`` and their 1-sigma, ``sqrt(cov_kk) / (2 p_k)`` from the generalised least-squares fit with
+        the covariance of the overlapping Allan variances (module docstring); NaN sigma for a term fitted as zero.
     identifiable : tuple of bool
     notes : tuple of str
-        Why a term is not identifiable, and what record would make it so.
+        Why a term is not identifiable, and what record would make it so (no values: those are ``upper`` and
+        ``needed``).
     dominant : tuple of str
-        The term dominant at each tau (used for the confidence intervals).
-    edf : ndarray
-    ci_low, ci_high : ndarray
+        The term dominant at each tau.
+    edf : ndarray, shape (T,)
+    ci_low, ci_high : ndarray, shape (T,)
         68.3 % interval of the deviation at each tau.
     readouts : dict
-        IEEE point readouts ``N_tau1``, ``B_floor``, ``K_tau3`` (SI; NaN where no
-        segment of the right slope exists).
+        IEEE point readouts (:data:`align.noise.readouts.READOUT_KEYS`): ``N_tau1``, ``B_floor``, ``K_tau3`` with
+        ``_lo``/``_hi`` 68.3 % bounds and ``B_floor_tau`` (SI; NaN where no region of the right slope exists).
+    cov : ndarray, shape (5, 5)
+        Covariance of the squared parameters ``Q^2 .. R^2`` at the estimate, ``(A' S^-1 A)^-1`` (NaN rows for terms
+        fitted as zero).
+    upper : ndarray, shape (5,)
+        One-sided 95 % upper bound of each term that is not identifiable (SI; NaN for identifiable terms).
+    needed : ndarray, shape (5,)
+        For each term that is not identifiable: the record length (s) at which a term as large as ``upper``
+        would be identifiable, or for ``Q`` and ``N`` the sample rate (Hz); NaN where none within 65536x.
+    method : str
     """
 
     params: np.ndarray
@@ -65,6 +101,10 @@ class NoiseFit(Value):
     ci_low: np.ndarray
     ci_high: np.ndarray
     readouts: dict
+    cov: np.ndarray = field(default_factory=lambda: np.full((5, 5), np.nan))
+    upper: np.ndarray = field(default_factory=lambda: np.full(5, np.nan))
+    needed: np.ndarray = field(default_factory=lambda: np.full(5, np.nan))
+    method: str = FIT_METHOD
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -78,39 +118,39 @@ class NoiseFit(Value):
         return NoiseModel.from_params(self.params)
 
 
-def nnls_small(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Non-negative least squares for a handful of unknowns, exactly, by enumerating supports.
-
-    The NNLS optimum is the unconstrained least-squares solution on its own
-    support with all coefficients positive; every such candidate is feasible,
-    so the best of them over all ``2^k`` supports is the optimum (k = 5 here:
-    32 tiny solves, and no scipy.optimize import on the command line's path).
-    """
-    k = a.shape[1]
-    best, best_r = np.zeros(k), float(b @ b)
-    for mask in range(1, 2**k):
-        cols = [j for j in range(k) if mask >> j & 1]
-        sol, *_ = np.linalg.lstsq(a[:, cols], b, rcond=None)
-        if np.all(sol > 0):
-            r = float(np.sum((a[:, cols] @ sol - b) ** 2))
-            if r < best_r:
-                best, best_r = np.zeros(k), r
-                best[cols] = sol
-    return best
+def _point_edf(res: AllanResult, channel: int, p: np.ndarray) -> tuple[np.ndarray, tuple]:
+    """EDF of each point: the result's own (per-tau identification) when it has them, else the fit's dominant term."""
+    contrib = avar_design(res.tau) * p[None, :]
+    dominant = tuple(TERMS[int(k)] for k in np.argmax(contrib, axis=1))
+    own = getattr(res, "edf", None)
+    if own is not None:
+        return np.asarray(own, dtype=float)[channel], dominant
+    return edf_overlapping(res.n_phase, res.m, np.array([NOISE_ALPHA[d] for d in dominant])), dominant
 
 
-def _nnls_fit(tau, avar, edf):
-    a = avar_design(tau)
-    w = np.sqrt(edf / 2.0) / avar          # 1 / (relative sigma of AVAR) / AVAR
-    aw, bw = a * w[:, None], avar * w
-    scale = np.linalg.norm(aw, axis=0)
-    scale[scale == 0] = 1.0
-    p = nnls_small(aw / scale, bw) / scale
-    return p, aw, bw
+def _interval(res: AllanResult, channel: int, adev: np.ndarray, edf: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    if hasattr(res, "interval"):
+        lo, hi = res.interval()
+        return np.asarray(lo)[channel], np.asarray(hi)[channel]
+    return confidence_interval(adev, edf)
 
 
 def fit_noise(res: AllanResult, channel: int, min_edf: float = 2.0, where: str | None = None) -> NoiseFit:
-    """Fit the five-term model to one channel of an :class:`AllanResult`.
+    """Fit the five-term model to one channel of an :class:`AllanResult` (module docstring: GLS, bounds).
+
+    Parameters
+    ----------
+    res : AllanResult
+        Overlapping Allan deviation, shape (C, T), in SI.
+    channel : int
+    min_edf : float
+        Points with fewer equivalent degrees of freedom are left out.
+    where : str, optional
+        The channel, for messages (by default its name).
+
+    Returns
+    -------
+    NoiseFit
 
     Raises
     ------
@@ -120,41 +160,102 @@ def fit_noise(res: AllanResult, channel: int, min_edf: float = 2.0, where: str |
     """
     tau, adev = res.tau, res.adev[channel]
     avar = adev**2
-    edf = edf_overlapping(res.n_phase, res.m, np.zeros(len(tau)))
+    edf, _ = _point_edf(res, channel, np.array([0.0, 1.0, 0.0, 0.0, 0.0]))
     _check_fittable(res, channel, (edf >= min_edf) & (avar > 0), where)
-    for _ in range(2):
+    p = np.zeros(5)
+    for _ in range(2):  # a start: weights from each point's EDF
         use = (edf >= min_edf) & (avar > 0)
-        p, aw, bw = _nnls_fit(tau[use], avar[use], edf[use])
-        contrib = avar_design(tau) * p[None, :]
-        dominant = tuple(TERMS[int(k)] for k in np.argmax(contrib, axis=1))
-        edf = edf_overlapping(res.n_phase, res.m, np.array([NOISE_ALPHA[d] for d in dominant]))
-    use = (edf >= min_edf) & (avar > 0)
-    p, aw, bw = _nnls_fit(tau[use], avar[use], edf[use])
+        w = np.sqrt(edf[use] / 2.0) / avar[use]
+        p = scaled_nnls(avar_design(tau[use]) * w[:, None], avar[use] * w)
+        edf, dominant = _point_edf(res, channel, p)
+    use = np.flatnonzero((edf >= min_edf) & (avar > 0))
+    pick = use[np.unique(np.round(np.linspace(0, len(use) - 1, min(FIT_POINTS, len(use)))).astype(int))]
+    a, y = avar_design(tau[pick]), avar[pick]
+    gls = GlsFit(a, y, avar_covariance_basis(res.m[pick], res.n_phase, res.fs),
+                 2 * np.maximum(a @ p, y) ** 2 / np.maximum(edf[pick], 1.0))
+    p, cov, _ = gls.solve(p, ITERATIONS)
     params = np.sqrt(p)
-    active = p > 0
-    cov = np.full((5, 5), np.nan)
-    dof = int(use.sum()) - int(active.sum())
-    if active.any():
-        sub = aw[:, active]
-        c = np.linalg.pinv(sub.T @ sub)
-        chi2 = float(np.sum((aw @ p - bw) ** 2))
-        c *= max(1.0, chi2 / dof) if dof > 0 else 1.0
-        cov[np.ix_(active, active)] = c
-    var_p = np.diag(cov)
-    sigma = np.where(active, np.sqrt(np.abs(var_p)) / (2 * np.where(params > 0, params, 1.0)), np.nan)
-    contrib = avar_design(tau) * p[None, :]
-    model = contrib.sum(axis=1)
-    share = np.where(use[:, None], contrib / np.maximum(model, 1e-300)[:, None], 0.0).max(axis=0)
-    ident, notes = [], []
-    lo, hi = confidence_interval(adev, edf)
-    for k, term in enumerate(TERMS):
-        rel = sigma[k] / params[k] if params[k] > 0 else np.inf
-        ok = bool(params[k] > 0 and share[k] >= 0.3 and rel < 0.25)
-        ident.append(ok)
-        if not ok:
-            notes.append(_why(term, params, share[k], rel, tau, use, hi, model, res))
-    return NoiseFit(params, sigma, tuple(ident), tuple(n for n in notes if n), dominant, edf, lo, hi,
-                    point_readouts(tau, adev))
+    upper = np.full(5, np.nan)
+    sigma = np.where(p > 0, np.sqrt(np.abs(np.diag(cov))) / (2 * np.where(params > 0, params, 1.0)), np.nan)
+    contrib = a * p[None, :]
+    share = (contrib / np.maximum(contrib.sum(axis=1), 1e-300)[:, None]).max(axis=0)
+    rel = np.where(p > 0, sigma / np.where(params > 0, params, 1.0), np.inf)
+    ident = (p > 0) & (share >= 0.3) & (rel < 0.25)
+    needed, notes = np.full(5, np.nan), []
+    edf_all, dominant = _point_edf(res, channel, p)
+    for k in np.flatnonzero(~ident):
+        upper[k] = _upper(k, p, tau[use], avar[use], edf_all[use])
+        needed[k] = _needed(k, upper[k], p, res)
+        notes.append(_note(k, p[k], share[k], rel[k], needed[k], res))
+    lo, hi = _interval(res, channel, adev, edf)
+    readouts = point_readouts(tau, adev, edf_all, lambda idx: avar_covariance(res.m[idx], res.n_phase, res.fs, params),
+                              params)
+    return NoiseFit(params, sigma, tuple(bool(i) for i in ident), tuple(notes), dominant, edf_all, lo, hi, readouts,
+                    cov, upper, needed)
+
+
+def _upper(k: int, p: np.ndarray, tau: np.ndarray, avar: np.ndarray, edf: np.ndarray) -> float:
+    """One-sided 95 % upper bound of term ``k``: the largest value whose curve stays under every point's bound.
+
+    Each point's bound is the one-sided chi-square one, ``AVAR edf / chi2_{1-POINT_LEVEL}(edf)`` (NIST SP 1065
+    Eq 5.34); the term alone may not exceed it anywhere (the other terms only add to the curve), so the bound is
+    set where the term rises fastest against the data: the long-tau end for K and R, the short-tau end for Q.
+    The minimum runs over several correlated points, so each is taken at :data:`POINT_LEVEL` (99 %) to keep
+    about 95 % overall (checked on simulated records, tests/noise/test_fit_coverage.py).
+    """
+    from scipy.special import gammaincinv
+
+    top = avar * edf / (2 * gammaincinv(edf / 2, 1 - POINT_LEVEL))
+    return float(np.sqrt(np.min(top / avar_design(tau)[:, k])))
+
+
+def _identifiable_at(k: int, p: np.ndarray, n: float, fs: float) -> bool:
+    """Whether term ``k`` of the squared parameters ``p`` is identifiable from an ``n``-sample record at ``fs``."""
+    m = tau_grid(int(n), fs, "dense", per_decade=2).astype(float)
+    a = avar_design(m / fs)
+    cols = np.flatnonzero(p > 0)
+    s = avar_covariance(m, n + 1, fs, np.sqrt(p), lags=32)
+    wh = whitener(s, np.diag(s) + 1e-300)
+    aw = wh @ a[:, cols]
+    var = np.linalg.pinv(aw.T @ aw)[list(cols).index(k), list(cols).index(k)]
+    contrib = a * p[None, :]
+    share = float(np.max(contrib[:, k] / np.maximum(contrib.sum(axis=1), 1e-300)))
+    return bool(share >= 0.3 and np.sqrt(max(var, 0.0)) / (2 * p[k]) < 0.25)
+
+
+def _needed(k: int, bound: float, p: np.ndarray, res: AllanResult) -> float:
+    """Record length (s; sample rate, Hz, for Q and N) at which a term ``k`` of size ``bound`` would be identifiable."""
+    if not bound > 0:
+        return float("nan")
+    q = p.copy()
+    q[k] = bound**2
+    rate = TERMS[k] in ("quantization", "white")
+    scale = (lambda j: (res.n * 2.0**j, res.fs * 2.0**j)) if rate else (lambda j: (res.n * 2.0**j, res.fs))
+    lo, hi = 0, 16
+    if not _identifiable_at(k, q, *scale(hi)):
+        return float("nan")
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        lo, hi = (lo, mid) if _identifiable_at(k, q, *scale(mid)) else (mid, hi)
+    n, fs = scale(hi)
+    return fs if rate else n / fs
+
+
+def _note(k: int, pk: float, share: float, rel: float, needed: float, res: AllanResult) -> str:
+    """Why term ``k`` is not identifiable and what would make it so (values live in ``upper``/``needed``)."""
+    term, hours = TERMS[k], res.n / res.fs / 3600
+    if pk <= 0:
+        why = "fitted as zero"
+    elif share < 0.3:
+        why = f"at most {100 * share:.0f} % of the curve at any tau"
+    else:
+        why = f"1-sigma {100 * rel:.0f} %"
+    head = f"{term} ({LETTERS[term]}): not identifiable from this {hours:.3g} h record ({why}); 95 % upper bound given"
+    if not np.isfinite(needed):
+        return head + "; no record up to 65536 times longer or faster would identify a term that size"
+    if term in ("quantization", "white"):
+        return head + f"; a sample rate of about {needed:.3g} Hz would identify a term that size"
+    return head + f"; about {needed / 3600:.3g} h of record would identify a term that size"
 
 
 def _check_fittable(res: AllanResult, channel: int, use: np.ndarray, where: str | None) -> None:
@@ -168,56 +269,6 @@ def _check_fittable(res: AllanResult, channel: int, use: np.ndarray, where: str 
                         "a column of zeros? record the sensor while it runs", where)
     raise TestError(f"the Allan deviation is 0 or unreliable at every tau of this {res.n:,}-sample record (nearly constant: "
                     "coarse quantisation?); record longer or at a finer resolution", where)
-
-
-def _why(term, params, share, rel, tau, use, hi, model, res) -> str:
-    """A sentence on why a term is not identifiable and, for slow terms, the record needed."""
-    T = res.n / res.fs
-    if params[TERMS.index(term)] > 0 and share >= 0.3:
-        return f"{term}: estimated but uncertain ({100 * rel:.0f} % 1-sigma)"
-    if term not in ("random_walk", "ramp"):
-        return f"{term}: never more than {100 * share:.0f} % of the curve; not identifiable from this record"
-    # the largest value the longest reliable tau (edf >= 5) allows, and where a term that size would show
-    reliable = np.flatnonzero(use & (res.n_phase - 2 * res.m >= 5))
-    last = reliable[-1] if len(reliable) else np.flatnonzero(use)[-1]
-    if not hi[last] ** 2 > model[last]:  # the fit already fills the interval: no room for a bound
-        return f"{term}: not identifiable from this {T / 3600:.3g} h record (largest share of the curve {100 * share:.0f} %)"
-    room = hi[last] ** 2 - model[last]
-    floor = max(FLICKER_FACTOR * params[2] ** 2 + params[1] ** 2 / tau[last], 1e-300)
-    if term == "random_walk":
-        bound = np.sqrt(3 * room / tau[last])
-        cross = 3 * floor / bound**2
-        symbol = "K"
-    else:
-        bound = np.sqrt(2 * room / tau[last] ** 2)
-        cross = np.sqrt(2 * floor) / bound
-        symbol = "R"
-    need = max(20 * cross, 2 * T)
-    return (f"{term}: not identifiable from this {T / 3600:.3g} h record (largest share of the curve {100 * share:.0f} %); "
-            f"{symbol} < {bound:.3g} (SI) here, and a term that size would dominate only beyond tau ~ {cross:.3g} s: "
-            f"about {need / 3600:.3g} h of record needed")
-
-
-def point_readouts(tau: np.ndarray, adev: np.ndarray) -> dict:
-    """IEEE Std 952 point readouts from the curve itself (labelled as such, not a fit).
-
-    ``N_tau1``: the slope -1/2 line through the points of local slope -1/2 +/- 0.1,
-    read at tau = 1 s; ``B_floor``: the curve minimum / 0.664; ``K_tau3``: the slope
-    +1/2 line through points of local slope +1/2 +/- 0.1, read at tau = 3 s.
-    """
-    out = {}
-    keep = np.asarray(adev) > 0  # a zero deviation has no logarithm
-    tau, adev = np.asarray(tau)[keep], np.asarray(adev)[keep]
-    if len(tau) == 0:
-        return {"N_tau1": float("nan"), "B_floor": 0.0, "K_tau3": float("nan")}
-    lt, la = np.log(tau), np.log(adev)
-    slope = np.gradient(la, lt) if len(tau) > 2 else np.zeros_like(tau)
-    white = np.abs(slope + 0.5) < 0.1
-    out["N_tau1"] = float(np.exp(np.median(la[white] + 0.5 * lt[white]))) if white.any() else float("nan")
-    out["B_floor"] = float(np.min(adev) / 0.664)
-    rw = np.abs(slope - 0.5) < 0.1
-    out["K_tau3"] = float(np.exp(np.median(la[rw] - 0.5 * lt[rw])) * np.sqrt(3.0)) if rw.any() else float("nan")
-    return out
 
 
 def noise_figures(y: np.ndarray, fs: float, periods=(1.0, 10.0)) -> dict:

@@ -1,28 +1,37 @@
-"""The Allan job: logs -> Allan deviation, fits, noise figures, plan; its JSON form.
+"""The Allan job: logs -> Allan deviation of every run, pooled curve, fits, noise figures, plan; its JSON form.
 
 :func:`run_allan` computes the overlapping (and modified) Allan deviation of
-the first run (:mod:`align.noise.allan`), fits the five-term IEEE model to each
-channel (:mod:`align.noise.fit`), and reads the seed's noise figures (bias,
-bias stability; seed 002 Eq 5-8) of every run. :class:`AllanJob` is the
-registered result (format ``imu-align.allan``): it writes itself with
-``to_dict`` and reads itself back with ``from_dict``. Its plot lives in
-:mod:`align.present.plots` (``allan_plot_png``).
+every run on one grid of taus (:mod:`align.noise.allan`) and fits the five-term
+IEEE model to each channel of each run (:mod:`align.noise.fit`). With several
+runs it pools them (:func:`pool_runs`): the pooled Allan variance at each tau is
+the average of the runs' Allan variances weighted by their numbers of second
+differences (the plain mean for runs of equal length), and its equivalent
+degrees of freedom (EDF) are the sum of theirs. The fit and the
+plan then use the pooled curve. The seed's noise figures (bias, bias stability;
+seed 002 Eq 5-8) are read from every run and averaged, and the run-to-run
+standard deviation of the bias is the repeatability. :class:`AllanJob` is the
+registered result (format ``imu-align.allan``, version 2: terms named as in
+:data:`align.noise.model.TERM_TABLE`; version 1 files read too). Its plot lives
+in :mod:`align.present.plots` (``allan_plot_png``).
 
 Public names
 ------------
-AllanJob, run_allan, read_runs, plan_from_allan, term_units, FORMAT
+AllanJob, run_allan, pool_runs, read_runs, plan_from_allan, term_units, FORMAT
 """
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 import numpy as np
 
 from align.errors import InputError
-from align.noise.allan import NOISE_ALPHA, AllanResult, allan, edf_overlapping
-from align.noise.fit import NoiseFit, fit_noise
-from align.noise.model import TERMS, avar_design
+from align.noise import jobfile as jf
+from align.noise.allan import AllanResult, allan, tau_grid
+from align.noise.fit import fit_noise
+from align.noise.jobfile import term_units
+from align.noise.model import TERM_TABLE
 from align.noise.planner import PlanResult, make_plan
 from align.plausible import check_static_rates
 from align.results import Result, file_unit
@@ -31,42 +40,32 @@ from align.wellformed import malformed
 
 FORMAT = "imu-align.allan"
 CONVENTION = ("overlapping Allan deviation (IEEE Std 1139, NIST SP 1065); noise model "
-              "sigma^2(tau) = 3 Q^2/tau^2 + N^2/tau + (2 ln 2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2 (IEEE Std 952)")
-
-#: display units of the five terms for gyros and accelerometers
-_GYRO = ("deg", "deg/sqrt(h)", "deg/h", "deg/h/sqrt(h)", "deg/h^2")
-_ACCEL = ("m/s", "m/s/sqrt(h)", "ug", "ug/sqrt(h)", "ug/h")
-_FIT_METHOD = "weighted non-negative least squares on the Allan variance (IEEE 952 five-term model)"
+              "sigma^2(tau) = 3 Q^2/tau^2 + N^2/tau + (2 ln 2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2 (IEEE Std 952); "
+              "several runs pooled: mean Allan variance weighted by the runs' second differences, EDF summed")
+POOLING = ("average Allan variance of the runs at each tau (weighted by their numbers of second differences: "
+           "equal runs weigh equally); its EDF is the sum of the runs' EDFs")
 _FIGURES_METHOD = ("seed 002 Eq 5-8: mean of each run; std (ddof 1) of consecutive P-second means, "
                    "averaged over runs")
-#: the IEEE point readouts: key in NoiseFit.readouts -> (JSON key, JSON unit key, term index)
-_READOUTS = {"N_tau1": ("N_at_tau_1s", "N_unit", 1), "B_floor": ("B_floor_over_0.664", "B_unit", 2),
-             "K_tau3": ("K_at_tau_3s", "K_unit", 3)}
-
-
-def term_units(units: str) -> tuple[str, ...]:
-    """Engineering units of Q, N, B, K, R for data in ``units`` (a rate or an acceleration)."""
-    u = parse_unit(units)
-    return _GYRO if u.dim == parse_unit("rad/s").dim else _ACCEL
-
 
 #: the fewest samples a recording may hold: a handful of taus per decade for the five-term fit
 MIN_SAMPLES = 100
 
 #: the keys of an Allan file after its envelope (a misspelled key is refused, not ignored)
 FILE_KEYS = ("sensor", "fs_hz", "samples", "runs", "tau", "m", "adev", "ci_low", "ci_high", "fit", "figures", "periods_s",
-             "adev_run_figures", "inputs", "mdev", "adev_of", "repeatability", "plan")
+             "adev_run_figures", "inputs", "mdev", "adev_of", "repeatability", "plan", "noise_type_alpha", "edf",
+             "edf_mdev", "pooled", "per_run")
 
 
-class AllanJob(Result, format=FORMAT, convention=CONVENTION):
+class AllanJob(Result, format=FORMAT, convention=CONVENTION, version=2):
     """Result of :func:`run_allan` (SI inside; ``units`` is the input unit).
 
     Attributes
     ----------
     result : AllanResult
-        Allan deviation of the first run, SI.
+        The curve fitted: the Allan deviation of the one run, or the pooled curve of several
+        (:func:`pool_runs`; ``n`` the samples of all runs; no bias figures), SI.
     fits : tuple of NoiseFit
-        One per channel.
+        One per channel, of ``result``.
     figures : tuple of dict
         One per channel: ``{"bias": float, "stability": {period_s: float}}``,
         averaged over the runs (SI).
@@ -76,9 +75,13 @@ class AllanJob(Result, format=FORMAT, convention=CONVENTION):
         Unit of the input data (a rate or an acceleration).
     runs : int
     inputs : tuple of str
-        The recordings, the first one being the one whose deviation is shown.
+        The recordings.
     plan : PlanResult or None
         A test plan from the curve, when one was asked for.
+    run_results : tuple of AllanResult
+        Each run's own curve (with its bias figures) when there are several; empty for one run.
+    run_fits : tuple of tuple of NoiseFit
+        Each run's fits, one per channel, when there are several.
     """
 
     result: AllanResult
@@ -89,73 +92,59 @@ class AllanJob(Result, format=FORMAT, convention=CONVENTION):
     runs: int
     inputs: tuple = ()
     plan: PlanResult | None = None
+    run_results: tuple = ()
+    run_fits: tuple = ()
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        for name in ("fits", "figures", "inputs"):
+        for name in ("fits", "figures", "inputs", "run_results"):
             object.__setattr__(self, name, tuple(getattr(self, name)))
+        object.__setattr__(self, "run_fits", tuple(tuple(f) for f in self.run_fits))
 
     @property
     def sensor(self) -> str:
         """``"gyroscope"`` for rate data, ``"accelerometer"`` otherwise."""
-        return "gyroscope" if term_units(self.units) is _GYRO else "accelerometer"
+        return "gyroscope" if term_units(self.units) is jf.GYRO else "accelerometer"
+
+    @property
+    def pooled(self) -> bool:
+        """True when ``result`` is the pooled curve of several runs."""
+        return len(self.run_results) > 1
 
     def to_dict(self) -> dict[str, Any]:
         """The versioned JSON form: deviations in ``units``, terms in engineering units."""
-        r, u = self.result, self.units
+        r, u, sensor = self.result, self.units, self.sensor
         tu = term_units(u)
         periods = list(self.figures[0]["stability"]) if self.figures else []
         d = {
             **self.envelope({"tau": "s", "adev": u, "ci": "68.3 % (1 sigma) chi-square interval",
-                             "terms": dict(zip(TERMS, tu)), "bias": u}),
-            "sensor": self.sensor, "fs_hz": r.fs, "samples": r.n, "runs": self.runs,
-            "tau": r.tau.tolist(),
-            "m": r.m.tolist(),
-            "adev": {n: to_unit(r.adev[j], u).tolist() for j, n in enumerate(r.names)},
-            "ci_low": {n: to_unit(f.ci_low, u).tolist() for n, f in zip(r.names, self.fits)},
-            "ci_high": {n: to_unit(f.ci_high, u).tolist() for n, f in zip(r.names, self.fits)},
-            "fit": {n: self._fit_dict(f, tu) for n, f in zip(r.names, self.fits)},
-            "figures": {n: {**_figures_dict(fig["bias"], fig["stability"], u), "method": _FIGURES_METHOD}
+                             "terms": {t.json_key(sensor): unit for t, unit in zip(TERM_TABLE, tu)}, "bias": u}),
+            "sensor": sensor, "fs_hz": r.fs, "samples": r.n, "runs": self.runs,
+            "tau": r.tau.tolist(), "m": r.m.tolist(),
+            **jf.curve_dict(r, self.fits, u, tu, sensor),
+            "figures": {n: {**jf.figures_dict(fig["bias"], fig["stability"], u), "method": _FIGURES_METHOD}
                         for n, fig in zip(r.names, self.figures)},
             "periods_s": periods,
-            "adev_run_figures": None if r.bias is None else {
-                n: _figures_dict(r.bias[j], {p: v[j] for p, v in (r.stability or {}).items()}, u)
-                for j, n in enumerate(r.names)},
+            "adev_run_figures": None if r.bias is None else jf.run_figures(r, u),
             "inputs": list(self.inputs),
         }
-        if r.mdev is not None:
-            d["mdev"] = {n: [None if not np.isfinite(v) else v for v in to_unit(r.mdev[j], u).tolist()]
-                         for j, n in enumerate(r.names)}
-        d["adev_of"] = self.inputs[0] if self.inputs else "first run"
+        d["adev_of"] = (f"pooled curve of {self.runs} runs: {POOLING}" if self.pooled
+                        else self.inputs[0] if self.inputs else "first run")
         if self.repeatability is not None:
             d["repeatability"] = {n: to_unit(v, u) for n, v in zip(r.names, self.repeatability)}
+        if self.pooled:
+            d["pooled"] = {"method": POOLING, "runs": len(self.run_results)}
+            d["per_run"] = [{"input": self.inputs[k] if k < len(self.inputs) else f"run {k + 1}", "samples": rr.n,
+                             **jf.curve_dict(rr, fits, u, tu, sensor), "figures": jf.run_figures(rr, u)}
+                            for k, (rr, fits) in enumerate(zip(self.run_results, self.run_fits))]
         if self.plan is not None:
             d["plan"] = self.plan.to_dict()
         return d
 
-    def _fit_dict(self, f: NoiseFit, tu: tuple[str, ...]) -> dict[str, Any]:
-        terms = {t: {"value": _term(f.params[k], tu[k]), "sigma": _term(f.sigma[k], tu[k]), "unit": tu[k],
-                     "identifiable": bool(f.identifiable[k])} for k, t in enumerate(TERMS)}
-        readouts = {}
-        for key, (name, unit_key, k) in _READOUTS.items():
-            readouts[name], readouts[unit_key] = _term(f.readouts[key], tu[k]), tu[k]
-        kind = self.sensor
-        return {
-            "method": _FIT_METHOD, "terms": terms, "notes": list(f.notes),
-            "ieee_point_readouts": readouts,
-            "continuous": {  # Kalibr-style densities, SI
-                f"{kind}_noise_density": float(f.params[1]),
-                f"{kind}_random_walk": float(f.params[3]),
-                "units": "rad/s/sqrt(Hz), rad/s^2/sqrt(Hz)" if kind == "gyroscope" else "m/s^2/sqrt(Hz), m/s^3/sqrt(Hz)",
-            },
-            "dominant": list(f.dominant),
-            "edf": f.edf.tolist(),
-        }
-
     @classmethod
     def from_dict(cls, d: dict[str, Any], where: str = "result") -> AllanJob:
-        """Read the form written by :meth:`to_dict` (files written before ``m``, ``edf``,
-        ``dominant`` and ``adev_run_figures`` were added read too: those are rebuilt)."""
+        """Read the form written by :meth:`to_dict`, or version 1 (internal term names; files written before
+        ``m``, ``edf``, ``dominant`` and ``adev_run_figures`` were added read too: those are rebuilt)."""
         cls.check_envelope(d, where, keys=FILE_KEYS)
         try:
             u, f = file_unit(d, "adev", None, where)
@@ -164,96 +153,91 @@ class AllanJob(Result, format=FORMAT, convention=CONVENTION):
             fs, n, runs = float(d["fs_hz"]), int(d["samples"]), int(d["runs"])
             tau = np.array(d["tau"], dtype=float)
             m = np.array(d["m"], dtype=np.int64) if "m" in d else np.round(tau * fs).astype(np.int64)
-            adev = np.array([d["adev"][k] for k in names], dtype=float) * f
-            mdev = np.array([d["mdev"][k] for k in names], dtype=float) * f if "mdev" in d else None
-            periods = _periods(d, names)
-            figures = tuple(_read_figures(d["figures"][k], periods, f) for k in names)
+            periods = jf.periods_of(d, names)
+            figures = tuple(jf.read_figures(d["figures"][k], periods, f) for k in names)
             run = d.get("adev_run_figures", d["figures"] if runs == 1 else None)
-            bias = stability = None
-            if run is not None:
-                own = [_read_figures(run[k], periods, f) for k in names]
-                bias = np.array([g["bias"] for g in own])
-                stability = {p: np.array([g["stability"][p] for g in own]) for p in periods}
-            result = AllanResult(tau, m, adev, mdev, n, fs, names, bias, stability)
-            fits = tuple(_read_fit(d["fit"][k], tu, result, np.array(d["ci_low"][k], dtype=float) * f,
-                                   np.array(d["ci_high"][k], dtype=float) * f) for k in names)
+            result, fits = jf.read_curve(d, tau, m, n, fs, names, f, tu, run, periods)
+            per = [jf.read_curve(p, tau, m, int(p["samples"]), fs, names, f, tu, p["figures"], periods)
+                   for p in d.get("per_run", ())]
             rep = d.get("repeatability")
             return cls(result, fits, figures, None if rep is None else np.array([rep[k] for k in names], dtype=float) * f,
                        u, runs, tuple(d.get("inputs", ())),
-                       PlanResult.from_dict(d["plan"], f"{where}: plan") if "plan" in d else None)
+                       PlanResult.from_dict(d["plan"], f"{where}: plan") if "plan" in d else None,
+                       tuple(p[0] for p in per), tuple(p[1] for p in per))
         except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
             raise InputError(f"malformed {FORMAT} result ({malformed(exc)}); regenerate it", where) from None
 
 
-def _term(value: float, unit: str) -> float | None:
-    """An SI term value in its engineering unit (None when not finite)."""
-    if not np.isfinite(value):
-        return None
-    return float(to_unit(value, unit))
+def pool_runs(results: list[AllanResult], edfs: list[np.ndarray]) -> AllanResult:
+    """The pooled curve of several runs on one grid of taus.
+
+    Parameters
+    ----------
+    results : list of AllanResult
+        The runs, K of them, each with deviations of shape (C, T) on the same ``m``.
+    edfs : list of ndarray, shape (C, T)
+        Each run's equivalent degrees of freedom ``nu_k`` at each tau.
+
+    Returns
+    -------
+    AllanResult
+        ``AVAR = sum_k (N_k - 2m) AVAR_k / sum_k (N_k - 2m)`` at each tau, ``N_k`` the phase points of run
+        ``k``: the overlapping Allan variance of all the runs' second differences together (IEEE Std 1139
+        / NIST SP 1065 Eq 14 summed over runs, none across a run boundary), the plain mean for runs of equal
+        length; its EDF is ``sum_k nu_k`` (independent runs: their chi-square degrees of freedom add, NIST
+        SP 1065 section 5.3). The modified deviation is pooled the same way with ``N_k - 3m + 1``.
+        ``n`` is the samples of all runs (the covariance of its points is about that of one record that long);
+        no bias figures. Its ``edf`` (and ``edf_mdev``) is the sum of the runs', its ``alpha`` the first run's
+        noise types.
+    """
+    first = results[0]
+    m = first.m.astype(float)
+    nu = np.stack([np.asarray(e, dtype=float) for e in edfs])
+    w = np.stack([np.broadcast_to(r.n_phase - 2 * m, r.adev.shape) for r in results])
+    pooled = np.sum(w * np.stack([r.adev**2 for r in results]), axis=0) / np.sum(w, axis=0)
+    mdev = None
+    if all(r.mdev is not None for r in results):
+        wm = np.stack([np.broadcast_to(np.maximum(r.n_phase - 3 * m + 1, 0), r.adev.shape) for r in results])
+        mdev = np.sqrt(np.sum(wm * np.stack([r.mdev**2 for r in results]), axis=0) / np.sum(wm, axis=0))
+    res = AllanResult(first.tau, first.m, np.sqrt(pooled), mdev, int(sum(r.n for r in results)), first.fs, first.names)
+    fields = {fl.name for fl in dataclasses.fields(AllanResult)}
+    extra = {}
+    if "edf" in fields:
+        extra["edf"] = np.sum(nu, axis=0)
+    if "edf_mdev" in fields and mdev is not None and all(getattr(r, "edf_mdev", None) is not None for r in results):
+        extra["edf_mdev"] = np.sum(np.stack([r.edf_mdev for r in results]), axis=0)
+    if "alpha" in fields and getattr(first, "alpha", None) is not None:
+        extra["alpha"] = np.asarray(first.alpha)
+    return res.replace(**extra) if extra else res
 
 
-def _si(value: float | None, factor: float) -> float:
-    """A value read from the file, in SI (None is NaN)."""
-    return float("nan") if value is None else float(value) * factor
-
-
-def _figures_dict(bias: float, stability: dict, units: str) -> dict[str, Any]:
-    return {"bias": to_unit(bias, units),
-            "bias_stability": {f"{p:g} s": to_unit(v, units) for p, v in stability.items()}}
-
-
-def _periods(d: dict[str, Any], names: tuple[str, ...]) -> list[float]:
-    """Averaging periods of the bias stability, s: ``periods_s``, else read off the keys ("10 s")."""
-    if "periods_s" in d:
-        return [float(p) for p in d["periods_s"]]
-    return [float(k.split()[0]) for k in d["figures"][names[0]]["bias_stability"]] if names else []
-
-
-def _read_figures(fig: dict[str, Any], periods: list[float], factor: float) -> dict[str, Any]:
-    values = list(fig["bias_stability"].values())
-    if len(values) != len(periods):
-        raise ValueError(f"{len(values)} bias stabilities for {len(periods)} periods")
-    return {"bias": _si(fig["bias"], factor), "stability": {p: _si(v, factor) for p, v in zip(periods, values)}}
-
-
-def _read_fit(fd: dict[str, Any], tu: tuple[str, ...], result: AllanResult, ci_low: np.ndarray,
-              ci_high: np.ndarray) -> NoiseFit:
-    """A :class:`NoiseFit` from its JSON form; ``dominant`` and ``edf`` are rebuilt when absent."""
-    factors = [parse_unit(t).factor for t in tu]
-    terms = [fd["terms"][t] for t in TERMS]
-    params = np.array([_si(t["value"], k) for t, k in zip(terms, factors)])
-    sigma = np.array([_si(t["sigma"], k) for t, k in zip(terms, factors)])
-    readouts = {key: _si(fd["ieee_point_readouts"][name], factors[k]) for key, (name, _, k) in _READOUTS.items()}
-    if "dominant" in fd:
-        dominant = tuple(fd["dominant"])
-    else:
-        dominant = tuple(TERMS[int(k)] for k in np.argmax(avar_design(result.tau) * params**2, axis=1))
-    if "edf" in fd:
-        edf = np.array(fd["edf"], dtype=float)
-    else:
-        edf = edf_overlapping(result.n_phase, result.m, np.array([NOISE_ALPHA[t] for t in dominant]))
-    return NoiseFit(params, sigma, tuple(bool(t["identifiable"]) for t in terms), tuple(fd.get("notes", ())),
-                    dominant, edf, ci_low, ci_high, readouts)
+def _edf_of(res: AllanResult, fits) -> np.ndarray:
+    """EDF of each point, shape (C, T): the result's own when it carries them, else the fits'."""
+    edf = getattr(res, "edf", None)
+    return np.asarray(edf, dtype=float) if edf is not None else np.stack([f.edf for f in fits])
 
 
 def run_allan(runs: list, fs: float, names: list[str], units: str, grid="dense", per_decade: int = 10,
               modified: bool = False, periods=(1.0, 10.0), progress=None, memory_limit: float = 2e9,
               where: str | list[str] | None = None) -> AllanJob:
-    """Allan deviation and fit of the first run, noise figures of every run, the repeatability.
+    """Allan deviation and fit of every run, the pooled curve of several, noise figures, repeatability.
 
     Parameters
     ----------
-    runs : list of array_like, shape (n, C), or chunk sources
+    runs : list of array_like, shape (n_k, C), or chunk sources
         Raw samples in ``units``; everything is computed on the raw numbers and
         scaled afterwards (deviations, means and stabilities are linear in the
-        unit), so no SI copy of a large record is made.
+        unit), so no SI copy of a large record is made. Several runs share the
+        taus of the shortest.
     fs : float
         Sample rate, Hz.
     names : list of str
         Channel names, C of them.
     units : str
         Unit of the samples (a rate or an acceleration).
-    grid, per_decade, modified, progress, memory_limit : see :func:`align.noise.allan.allan`
+    grid, per_decade, modified, memory_limit : see :func:`align.noise.allan.allan`
+    progress : callable, optional
+        Called with the number of samples read so far, over all runs.
     periods : sequence of float
         Averaging periods (s) of the bias stability (seed 002 Eq 7).
     where : str or list of str, optional
@@ -262,7 +246,8 @@ def run_allan(runs: list, fs: float, names: list[str], units: str, grid="dense",
     Returns
     -------
     AllanJob
-        Set its ``inputs`` (and ``plan``) with ``job.replace(...)``.
+        Its ``result`` and ``fits`` are the pooled curve's when there are several runs
+        (:func:`pool_runs`). Set its ``inputs`` (and ``plan``) with ``job.replace(...)``.
 
     Raises
     ------
@@ -276,24 +261,29 @@ def run_allan(runs: list, fs: float, names: list[str], units: str, grid="dense",
         raise InputError(f"the sample rate must be a finite number of Hz > 0, not {float(fs)!r}", "{rate_hz}")
     factor = parse_unit(units).factor
     files = list(where) if isinstance(where, (list, tuple)) else [where] * len(runs)
-    for run, file in zip(runs, files):
-        n = np.shape(run)[0] if not hasattr(run, "chunks") else run.shape[0]
+    sizes = [run.shape[0] if hasattr(run, "chunks") else np.shape(run)[0] for run in runs]
+    for n, file in zip(sizes, files):
         if n < MIN_SAMPLES:
             raise InputError(f"only {n} samples; an Allan deviation and its fit need at least {MIN_SAMPLES} (several "
                              "taus per decade): record longer", file or "record")
-    # the deviations of the first run; of the others only the bias figures (no kernel pass)
-    results = [allan(r, fs, names, grid, per_decade, modified, memory_limit, progress=progress if k == 0 else None,
-                     periods=periods, deviations=k == 0, where=file) for k, (r, file) in enumerate(zip(runs, files))]
-    results = [r.scaled(factor) for r in results]
-    res = results[0]
-    fits = tuple(fit_noise(res, j, where=f"{files[0]}: {name}" if files[0] else None) for j, name in enumerate(names))
+    taus = grid if len(runs) == 1 else list(tau_grid(min(sizes), fs, grid, per_decade) / fs)
+    offsets = np.concatenate([[0], np.cumsum(sizes)])
+    results = [allan(r, fs, names, taus, per_decade, modified, memory_limit, periods=periods, where=file,
+                     progress=None if progress is None else (lambda k, off=int(offsets[i]): progress(off + k))).scaled(factor)
+               for i, (r, file) in enumerate(zip(runs, files))]
+    run_fits = [tuple(fit_noise(res, j, where=f"{file}: {name}" if file else None) for j, name in enumerate(names))
+                for res, file in zip(results, files)]
     figures = tuple({"bias": float(np.mean([r.bias[j] for r in results])),
                      "stability": {p: float(np.mean([r.stability[p][j] for r in results])) for p in periods}}
                     for j in range(len(names)))
     if parse_unit(units).dim == DIMENSIONS["angular_rate"][0].dim:  # raw counts read as a rate are refused
         check_static_rates(np.array([f["bias"] for f in figures]), units, list(names), "gyro_units", files[0])
-    rep = np.std([r.bias for r in results], axis=0, ddof=1) if len(results) > 1 else None
-    return AllanJob(res, fits, figures, rep, units, len(runs))
+    if len(runs) == 1:
+        return AllanJob(results[0], run_fits[0], figures, None, units, 1)
+    pooled = pool_runs(results, [_edf_of(r, f) for r, f in zip(results, run_fits)])
+    fits = tuple(fit_noise(pooled, j, where=f"pooled runs: {name}") for j, name in enumerate(names))
+    rep = np.std([r.bias for r in results], axis=0, ddof=1)
+    return AllanJob(pooled, fits, figures, rep, units, len(runs), run_results=tuple(results), run_fits=tuple(run_fits))
 
 
 def read_runs(paths: list, columns: list[str], rate_hz: float | None = None, log_format=None,
@@ -364,4 +354,6 @@ def plan_from_allan(job: AllanJob, rate: float, accuracy: float, noise_ratio: fl
         raise InputError(f"holds {job.sensor} data ({job.units}); a test plan needs a gyro's", where)
     r = job.result
     source = source or f"measured curve (worst of {', '.join(r.names)})"
+    if job.pooled:
+        source += f", pooled over {job.runs} runs"
     return make_plan(rate, accuracy, noise_ratio, source, tau=r.tau, adev=r.adev.max(axis=0), **common)

@@ -11,9 +11,14 @@ bias instability ``B`` (rad/s; the curve's floor is ``sqrt(2 ln 2 / pi) B =
 linear in the squared parameters, which the fit (:mod:`align.noise.fit`) uses;
 the planner (:mod:`align.noise.planner`) evaluates it as a curve.
 
+The names engineers use (quantization Q, angle random walk N -- velocity
+random walk for an accelerometer --, bias instability B, rate random walk K --
+acceleration random walk --, rate ramp R) are in one table, :data:`TERM_TABLE`;
+the internal keys of :data:`TERMS` stay as the code's field names.
+
 Public names
 ------------
-TERMS, NOISE_ALPHA, FLICKER_FACTOR, avar_design, model_avar, model_adev, NoiseModel
+TERMS, Term, TERM_TABLE, term, NOISE_ALPHA, FLICKER_FACTOR, avar_design, model_avar, model_adev, NoiseModel
 """
 
 from __future__ import annotations
@@ -24,11 +29,68 @@ import numpy as np
 
 from align.values import Value
 
-#: the five terms, in the order of every parameter vector ``(Q, N, B, K, R)``
+#: the five terms' internal keys, in the order of every parameter vector ``(Q, N, B, K, R)``
 TERMS = ("quantization", "white", "flicker", "random_walk", "ramp")
 
+
+@dataclass(frozen=True)
+class Term:
+    """One term of the model as engineers name it (IEEE Std 952 / 1554 letters).
+
+    ``key`` is the internal name (the field of :class:`NoiseModel`, the order of :data:`TERMS`);
+    ``symbol`` the IEEE letter; ``gyro`` / ``accel`` the name for a gyroscope / an accelerometer;
+    ``alpha`` the power-law exponent of the frequency PSD; ``units`` the engineering units
+    ``(gyroscope, accelerometer)`` it is shown in (SI inside).
+    """
+
+    key: str
+    symbol: str
+    gyro: str
+    accel: str
+    alpha: int
+    units: tuple
+
+    def unit(self, sensor: str = "gyroscope") -> str:
+        """The engineering unit shown, e.g. ``deg/sqrt(h)`` (``m/s/sqrt(h)`` for an accelerometer)."""
+        return self.units[0] if sensor == "gyroscope" else self.units[1]
+
+    def name(self, sensor: str = "gyroscope") -> str:
+        """The engineering name, e.g. ``angle random walk`` (``velocity random walk`` for an accelerometer)."""
+        return self.gyro if sensor == "gyroscope" else self.accel
+
+    def json_key(self, sensor: str = "gyroscope") -> str:
+        """The name written in a result file, e.g. ``angle_random_walk``."""
+        return self.name(sensor).replace(" ", "_")
+
+    def label(self, sensor: str = "gyroscope") -> str:
+        """``N (angle random walk)``: the letter and the name, as messages print it."""
+        return f"{self.symbol} ({self.name(sensor)})"
+
+
+#: the one vocabulary of the five terms (terminal, JSON, report, plot), in the order of :data:`TERMS`
+TERM_TABLE = (
+    Term("quantization", "Q", "quantization", "quantization", 2, ("deg", "m/s")),
+    Term("white", "N", "angle random walk", "velocity random walk", 0, ("deg/sqrt(h)", "m/s/sqrt(h)")),
+    Term("flicker", "B", "bias instability", "bias instability", -1, ("deg/h", "ug")),
+    Term("random_walk", "K", "rate random walk", "acceleration random walk", -2, ("deg/h/sqrt(h)", "ug/sqrt(h)")),
+    Term("ramp", "R", "rate ramp", "acceleration ramp", -2, ("deg/h^2", "ug/h")),
+)
+_BY_NAME = {n: t for t in TERM_TABLE for n in (t.key, t.symbol, t.json_key("gyroscope"), t.json_key("accelerometer"))}
+
+
+def term(name: str) -> Term:
+    """The :class:`Term` of an internal key, an IEEE letter or a file name of either sensor.
+
+    Raises
+    ------
+    KeyError
+        An unknown name.
+    """
+    return _BY_NAME[name]
+
+
 #: power-law exponent alpha of the frequency PSD (S_y ~ f^alpha) for each noise term
-NOISE_ALPHA = {"quantization": 2, "white": 0, "flicker": -1, "random_walk": -2, "ramp": -2}
+NOISE_ALPHA = {t.key: t.alpha for t in TERM_TABLE}
 
 #: the flicker (bias instability) coefficient of the Allan variance, 2 ln 2 / pi
 FLICKER_FACTOR = 2 * np.log(2) / np.pi

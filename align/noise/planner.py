@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from align.errors import InputError
-from align.noise.model import NoiseModel
+from align.noise.model import FLICKER_FACTOR, NoiseModel
 from align.parts import Part
 from align.results import Result
 from align.units import DEG, DEG_H
@@ -51,24 +51,38 @@ def model_curve(white: float, flicker: float = 0.0, random_walk: float = 0.0, qu
 
 def preset_model(part: Part, where: str = "{imu}") -> tuple[str, NoiseModel]:
     """The noise model of a datasheet preset: its angle random walk (or noise density) and
-    bias instability, with the label a plan states as its noise source."""
+    bias instability, with the label a plan states as its noise source. A preset that states no bias
+    instability gives a white-noise model: no floor (the label says so)."""
     n = part.si("arw", "angle_random_walk") or part.si("noise_density", "angle_random_walk")
     if n is None:
         raise InputError(f"{part.name} has no angle random walk or noise density in the preset table", where)
-    return f"datasheet preset {part.name}", model_curve(n, part.si("bias_instability", "angular_rate") or 0.0)
+    b = part.si("bias_instability", "angular_rate") or 0.0
+    label = f"datasheet preset {part.name}" + ("" if b else ", angle random walk only (it states no bias instability)")
+    return label, model_curve(n, b)
 
 
 @dataclass(frozen=True, eq=False)
 class Averaging(Value):
     """Shortest averaging time meeting a target on the falling branch, or why none does.
 
-    ``tau`` (s, None when infeasible), the curve's ``floor`` (rad/s) at ``floor_tau`` (s), ``reason``.
+    ``tau`` (s, None when infeasible); the curve's ``floor`` (rad/s; None when the curve has
+    none: white noise alone averages down without limit) at ``floor_tau`` (s; None when the
+    floor is only approached as tau grows, bias instability without a rising term); ``reason``.
     """
 
     tau: float | None
-    floor: float
-    floor_tau: float
+    floor: float | None
+    floor_tau: float | None
     reason: str
+
+
+def _model_floor(model: NoiseModel) -> tuple[float | None, float | None] | None:
+    """The floor of a model without a rising term (K, R): None (white noise, quantization: no floor) or
+    ``(sqrt(2 ln 2 / pi) B, None)`` approached as tau grows (IEEE Std 952); ``None`` result for a model
+    with a rising term (its floor is an interior minimum, found numerically)."""
+    if model.random_walk > 0 or model.ramp > 0:
+        return None
+    return (float(np.sqrt(FLICKER_FACTOR) * model.flicker), None) if model.flicker > 0 else (None, None)
 
 
 def averaging_time(target: float, tau: np.ndarray | None = None, adev: np.ndarray | None = None, sigma=None) -> Averaging:
@@ -76,11 +90,26 @@ def averaging_time(target: float, tau: np.ndarray | None = None, adev: np.ndarra
 
     Give either a measured curve (``tau``, ``adev``; interpolated log-log, and
     extrapolated along a white-noise slope -1/2 below its first point, which is
-    then said) or a model ``sigma`` callable.
+    then said) or a model ``sigma`` callable. A :class:`~align.noise.model.NoiseModel`
+    without rate random walk or ramp has no interior minimum: with bias
+    instability its floor is ``0.664 B`` (IEEE Std 952), approached as tau grows;
+    with white noise (and quantization) alone it has no floor.
     """
     from scipy.optimize import brentq, minimize_scalar
 
     if sigma is not None:
+        known = _model_floor(sigma) if isinstance(sigma, NoiseModel) else None
+        if known is not None:
+            floor, t_floor = known
+            if floor is not None and target <= floor:
+                return Averaging(None, floor, None, _infeasible(target, floor))
+            if float(sigma(1e-9)) <= target:
+                return Averaging(1e-9, floor, None, "met at any averaging time")
+            hi = 1.0
+            while float(sigma(hi)) > target:
+                hi *= 10.0
+            lt = brentq(lambda x: float(sigma(np.exp(x))) - target, np.log(1e-9), np.log(hi), xtol=1e-12)
+            return Averaging(float(np.exp(lt)), floor, None, "model curve")
         res = minimize_scalar(lambda lt: float(sigma(np.exp(lt))), bounds=(np.log(1e-6), np.log(1e7)), method="bounded")
         t_floor, floor = float(np.exp(res.x)), float(sigma(np.exp(res.x)))
         if target < floor:
@@ -128,7 +157,7 @@ FILE_KEYS = ("rate_deg_s", "accuracy_deg", "noise_ratio", "noise_target_deg_h", 
              "floor_deg_h", "floor_tau_s", "noise_source", "angle_method", "test_plan", "inputs")
 
 
-class PlanResult(Result, format=FORMAT, convention=CONVENTION):
+class PlanResult(Result, format=FORMAT, convention=CONVENTION, version=2):
     """A test plan from the noise (SI units: rad/s, rad, s).
 
     Attributes
@@ -173,7 +202,8 @@ class PlanResult(Result, format=FORMAT, convention=CONVENTION):
         return None if self.averaging.tau is None else self.averaging.tau + self.settle
 
     def to_dict(self) -> dict[str, Any]:
-        """The versioned JSON form (deg, deg/s, deg/h, s)."""
+        """The versioned JSON form (deg, deg/s, deg/h, s); version 2: ``floor_deg_h`` and ``floor_tau_s`` are
+        null when the curve has no floor (white noise alone) or reaches it only as tau grows."""
         a, dwell = self.averaging, self.dwell
         return {
             **self.envelope({"noise_target_deg_h": "deg/h", "averaging_time_s": "s", "rate_deg_s": "deg/s",
@@ -186,7 +216,7 @@ class PlanResult(Result, format=FORMAT, convention=CONVENTION):
             "averaging_time_s": a.tau,
             "feasible": a.tau is not None,
             "reason": a.reason,
-            "floor_deg_h": a.floor / DEG_H, "floor_tau_s": a.floor_tau,
+            "floor_deg_h": None if a.floor is None else a.floor / DEG_H, "floor_tau_s": a.floor_tau,
             "noise_source": self.source,
             "angle_method": {"turn_angle_deg": self.turn_angle / DEG, "longest_turn_s": self.longest_turn},
             "test_plan": {"steps": self.steps, "settle_s": self.settle, "dwell_s": dwell,
@@ -204,8 +234,9 @@ class PlanResult(Result, format=FORMAT, convention=CONVENTION):
             return cls(
                 rate=float(d["rate_deg_s"]) * DEG, accuracy=float(d["accuracy_deg"]) * DEG,
                 noise_ratio=float(d["noise_ratio"]), noise_target=float(d["noise_target_deg_h"]) * DEG_H,
-                averaging=Averaging(None if tau is None else float(tau), float(d["floor_deg_h"]) * DEG_H,
-                                    float(d["floor_tau_s"]), str(d["reason"])),
+                averaging=Averaging(None if tau is None else float(tau),
+                                    None if d["floor_deg_h"] is None else float(d["floor_deg_h"]) * DEG_H,
+                                    None if d["floor_tau_s"] is None else float(d["floor_tau_s"]), str(d["reason"])),
                 turn_angle=float(am["turn_angle_deg"]) * DEG,
                 longest_turn=None if am["longest_turn_s"] is None else float(am["longest_turn_s"]),
                 steps=int(tp["steps"]), settle=float(tp["settle_s"]), source=str(d["noise_source"]),

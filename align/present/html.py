@@ -150,6 +150,18 @@ def allowance_section(allow, margins=None, basis: str = "rss") -> Section:
     return Section("What the manoeuvre allows", body)
 
 
+def _term_cells(t: dict) -> list[str]:
+    """Value and 1-sigma of an identifiable term; else "not identified" and its upper bound, with what would identify it."""
+    if t["identifiable"]:
+        return [f"{t['value']:.4g}", "" if t["sigma"] is None else f"± {t['sigma']:.2g} (1 sigma)"]
+    bound = "" if t.get("upper_bound") is None else f"< {t['upper_bound']:.3g} (95 %)"
+    if t.get("record_to_identify_h") is not None:
+        bound += f"; about {t['record_to_identify_h']:.3g} h of record would identify it"
+    elif t.get("sample_rate_to_identify_hz") is not None:
+        bound += f"; a sample rate of about {t['sample_rate_to_identify_hz']:.3g} Hz would identify it"
+    return ["not identified", bound.lstrip("; ")]
+
+
 def allan_section(job: AllanJob | None, plot_png: bytes | None, plan: PlanResult | None) -> Section:
     """Allan deviation, fitted terms and the test plan."""
     body = ""
@@ -159,21 +171,33 @@ def allan_section(job: AllanJob | None, plot_png: bytes | None, plan: PlanResult
         u = allan_dict["units"]
         rows = []
         for name, fit in allan_dict["fit"].items():
-            for term, t in fit["terms"].items():
-                val = "-" if not t["value"] else f"{t['value']:.4g}"
-                rows.append([name, term, val, t["unit"], "yes" if t["identifiable"] else "no"])
-        body += (f"<p>{allan_dict['samples']:,} samples at {allan_dict['fs_hz']:g} Hz, data in {esc(u['adev'])}; "
-                 f"confidence band {esc(u['ci'])}.</p>"
-                 + table(["channel", "term", "value", "unit", "identifiable"], rows, left=2))
+            for t in fit["terms"].values():
+                rows.append([name, f"{t['symbol']} {t['name']}", *_term_cells(t), t["unit"]])
+            r = fit["ieee_point_readouts"]
+            b = r.get("B_floor_over_0.664")
+            if b is not None:
+                lo, hi = r.get("B_floor_over_0.664_low"), r.get("B_floor_over_0.664_high")
+                at = r.get("B_floor_tau_s")
+                rows.append([name, "floor (IEEE point readout)", f"{0.664 * b:.4g}",
+                             "" if lo is None or hi is None else f"68 %: {0.664 * lo:.4g}-{0.664 * hi:.4g}"
+                             + ("" if at is None else f" at tau {at:.3g} s"), r["B_unit"]])
+        d = allan_dict
+        runs = (f"pooled curve of {d['runs']} runs ({esc(d['pooled']['method'])}); " if "pooled" in d
+                else f"{d['samples']:,} samples at {d['fs_hz']:g} Hz, ")
+        body += (f"<p>{runs}data in {esc(u['adev'])}; confidence band {esc(u['ci'])}. A term's value is given only "
+                 "where the record identifies it; otherwise its 95 % upper bound.</p>"
+                 + table(["channel", "term", "value", "uncertainty or bound", "unit"], rows, left=2))
     if plot_png:
         body += image(plot_png, "Allan deviation with confidence band, fit, target and averaging time")
     if plan_dict is not None:
         p = plan_dict
         avg = "none" if p["averaging_time_s"] is None else f"{p['averaging_time_s']:.4g} s"
+        floor = ("none (white noise alone)" if p["floor_deg_h"] is None else f"{p['floor_deg_h']:.4g} deg/h"
+                 + (" (0.664 B, approached as tau grows)" if p["floor_tau_s"] is None else f" at tau {p['floor_tau_s']:.3g} s"))
         body += table(["test plan", "value"], [
             ["table rate", f"{p['rate_deg_s']:g} deg/s"], ["alignment goal", f"{p['accuracy_deg']:g} deg"],
             ["noise ratio", f"{p['noise_ratio']:g}"], ["noise target", f"{p['noise_target_deg_h']:.4f} deg/h"],
-            ["averaging time per step", avg], ["reason", p["reason"]],
+            ["curve floor", floor], ["averaging time per step", avg], ["reason", p["reason"]],
             ["total table time", "-" if p["test_plan"]["total_table_time_s"] is None
              else f"{p['test_plan']['total_table_time_s']:.4g} s"],
             ["noise source", p["noise_source"]]])

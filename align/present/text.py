@@ -11,6 +11,8 @@ allan_summary, plan_summary, calibration_summary, magnetometer_summary
 
 from __future__ import annotations
 
+import re
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -145,31 +147,83 @@ def margin_summary(rows, basis: str) -> str:
     return "\n".join(lines)
 
 
+def _num(v) -> str:
+    return "-" if v is None else f"{v:.4g}"
+
+
+def _term_line(t: dict, notes: list[str]) -> str:
+    """One term: its value ± 1-sigma when identifiable; else why not, its upper bound and what would identify it."""
+    head = f"    {t['symbol']}  {t['name']:<25}"
+    if t["identifiable"]:
+        sig = "" if t["sigma"] is None else f" ± {t['sigma']:.2g}"
+        return f"{head} {t['value']:.4g}{sig} {t['unit']}"
+    own = next((n for n in notes if n.startswith(f"{t['symbol']} (")), "")
+    why = re.search(r"record \(([^()]*)\)", own)
+    line = f"{head} not identified" + (f" ({why.group(1)})" if why else "")
+    if t.get("upper_bound") is not None:
+        line += f"; < {t['upper_bound']:.3g} {t['unit']} (95 % upper bound)"
+    if t.get("record_to_identify_h") is not None:
+        line += f"; about {t['record_to_identify_h']:.3g} h of record would identify it"
+    elif t.get("sample_rate_to_identify_hz") is not None:
+        line += f"; a sample rate of about {t['sample_rate_to_identify_hz']:.3g} Hz would identify it"
+    return line
+
+
+def _readouts_line(r: dict) -> str:
+    """The IEEE point readouts: N at tau = 1 s, the floor with its 68 % interval and tau, K at tau = 3 s."""
+    b = r.get("B_floor_over_0.664")
+    floor = "-" if b is None else f"{0.664 * b:.4g} {r['B_unit']}"
+    lo, hi = r.get("B_floor_over_0.664_low"), r.get("B_floor_over_0.664_high")
+    if b is not None and lo is not None and hi is not None:
+        floor += f" (68 %: {0.664 * lo:.4g}-{0.664 * hi:.4g})"
+    if b is not None and r.get("B_floor_tau_s") is not None:
+        floor += f" at tau {r['B_floor_tau_s']:.3g} s"
+    return (f"    IEEE point readouts: N (line at tau = 1 s) {_num(r['N_at_tau_1s'])} {r['N_unit']}; "
+            f"floor {floor}, B = floor/0.664 {_num(b)} {r['B_unit']}; "
+            f"K (line at tau = 3 s) {_num(r['K_at_tau_3s'])} {r['K_unit']}")
+
+
+#: the start of a note on one term: "N (angle random walk): " (this version) or "white: " (version 1 files)
+_TERM_NOTE = re.compile(r"^([QNBKR] \([a-z ]+\)|quantization|white|flicker|random_walk|ramp): ")
+
+
+def _fit_lines(fit: dict) -> list[str]:
+    """The five terms, the readouts, and the notes that are not about one term (those are on its line)."""
+    notes = list(fit["notes"])
+    lines = [_term_line(t, notes) for t in fit["terms"].values()]
+    lines.append(_readouts_line(fit["ieee_point_readouts"]))
+    lines += [f"    note: {n}" for n in notes if not _TERM_NOTE.match(n)]
+    return lines
+
+
 def allan_summary(job: AllanJob) -> str:
-    """The table ``imu-align allan`` prints (values in the job's file units)."""
+    """The table ``imu-align allan`` prints (values in the job's file units, terms in engineering units).
+
+    With several runs: each run's line, then the pooled curve's terms (the fit and the plan use it).
+    """
+    from align.noise.model import term
+
     d = job.to_dict()
     u = d["units"]
-    lines = [f"Allan deviation: {d['samples']:,} samples at {d['fs_hz']:g} Hz ({d['samples'] / d['fs_hz'] / 3600:.3g} h), "
-             f"{len(d['tau'])} taus, {d['runs']} run(s); {d['sensor']} data in {u['adev']}", ""]
+    tau = d["tau"]
+    hours = (d["per_run"][0]["samples"] if job.pooled else d["samples"]) / d["fs_hz"] / 3600
+    lines = [f"Allan deviation: {d['runs']} run(s) of {hours:.3g} h at {d['fs_hz']:g} Hz, {len(tau)} taus "
+             f"({tau[0]:.3g}-{tau[-1]:.3g} s); {d['sensor']} data in {u['adev']}"]
+    if job.pooled:
+        lines.append(f"  pooled curve: {d['pooled']['method']}; the fit and the plan use it")
+        n_key = term("white").json_key(job.sensor)
+        for p in d["per_run"]:
+            ns = ", ".join(f"{name} {_num(f['terms'][n_key]['estimate'])}" for name, f in p["fit"].items())
+            lines.append(f"  run {Path(p['input']).name}: {p['samples']:,} samples; N fitted {ns} {d['units']['terms'][n_key]}")
+    lines.append("")
     for name, fit in d["fit"].items():
-        lines.append(f"  {name}")
-        for term, t in fit["terms"].items():
-            val = "-" if t["value"] is None or t["value"] == 0 else f"{t['value']:.4g}"
-            sig = "" if t["sigma"] is None else f" ± {t['sigma']:.2g}"
-            flag = "" if t["identifiable"] else "   (not identifiable)"
-            lines.append(f"    {term:<13} {val:>10}{sig:<10} {t['unit']:<14}{flag}")
-        r = fit["ieee_point_readouts"]
-        fmt = lambda v: "-" if v is None else f"{v:.4g}"  # noqa: E731
-        lines.append(f"    IEEE point readouts: N(tau=1 s) {fmt(r['N_at_tau_1s'])} {r['N_unit']}, "
-                     f"floor/0.664 {fmt(r['B_floor_over_0.664'])} {r['B_unit']}, "
-                     f"K(tau=3 s) {fmt(r['K_at_tau_3s'])} {r['K_unit']}")
+        lines.append(f"  {name}" + (" (pooled curve)" if job.pooled else ""))
+        lines += _fit_lines(fit)
         fig = d["figures"][name]
         stab = ", ".join(f"{p}: {v:.4g}" for p, v in fig["bias_stability"].items())
         lines.append(f"    bias {fig['bias']:.6g} {u['bias']}; bias stability ({stab}) {u['bias']}")
         if "repeatability" in d:
             lines.append(f"    bias repeatability over {d['runs']} runs: {d['repeatability'][name]:.4g} {u['bias']}")
-        for note in fit["notes"]:
-            lines.append(f"    note: {note}")
         lines.append("")
     return "\n".join(lines).rstrip()
 
@@ -178,10 +232,16 @@ def plan_summary(plan: PlanResult) -> str:
     """The text ``imu-align plan`` prints."""
     d = plan.to_dict()
     tp = d["test_plan"]
+    if d["floor_deg_h"] is None:
+        floor = "none (white noise alone averages down without limit)"
+    elif d["floor_tau_s"] is None:
+        floor = f"{d['floor_deg_h']:.4g} deg/h (0.664 B, approached as tau grows)"
+    else:
+        floor = f"{d['floor_deg_h']:.4g} deg/h at tau {d['floor_tau_s']:.3g} s"
     lines = [f"Test plan: table rate {d['rate_deg_s']:g} deg/s, alignment goal {d['accuracy_deg']:g} deg, "
              f"noise {d['noise_ratio']:g}x below it ({d['noise_source']})",
              f"  noise target        {d['noise_target_deg_h']:.4f} deg/h  (rate x sin(goal) / ratio, Example 3)",
-             f"  curve floor         {d['floor_deg_h']:.4g} deg/h at tau {d['floor_tau_s']:.3g} s"]
+             f"  curve floor         {floor}"]
     if d["feasible"]:
         lines.append(f"  averaging time      {d['averaging_time_s']:.4g} s per step  ({d['reason']})")
         lines.append(f"  whole test          {tp['steps']} steps x "

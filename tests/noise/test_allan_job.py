@@ -10,7 +10,7 @@ ADIS = SHARED / "data" / "static" / "adis16405_smac"
 
 
 def test_allan_cli_on_real_adis16405_and_plan_from_it(tmp_path, run_cli):
-    """Two 2.78 h static runs of an ADIS16405: figures per run, repeatability, plot, plan."""
+    """Two 2.78 h static runs of an ADIS16405: each run's curve and fit, the pooled curve, repeatability, plot, plan."""
     out, png = tmp_path / "allan.json", tmp_path / "allan.png"
     runs = [ADIS / "adis_16405_imu1.csv.gz", ADIS / "adis_16405_imu2.csv.gz"]
     res = run_cli("allan", *runs, "--columns", "gyro_x_dps,gyro_y_dps,gyro_z_dps", "--rate-hz", "100",
@@ -22,12 +22,15 @@ def test_allan_cli_on_real_adis16405_and_plan_from_it(tmp_path, run_cli):
     assert d["units"]["adev"] == "deg/s" and d["runs"] == 2
     assert png.read_bytes()[:4] == b"\x89PNG"
     for name, fit in d["fit"].items():
-        n_fit = fit["terms"]["white"]["value"]
+        n_fit = fit["terms"]["angle_random_walk"]["value"]
         n_read = fit["ieee_point_readouts"]["N_at_tau_1s"]
         assert 1.5 < n_fit < 3.0  # deg/sqrt(h): the white-noise level of this part's class
         assert n_fit == pytest.approx(n_read, rel=0.15)  # the fit and the IEEE readout agree
         lo, hi, a = (np.array(d[k][name]) for k in ("ci_low", "ci_high", "adev"))
         assert np.all(lo <= a) and np.all(a <= hi)
+        # the pooled curve is the mean Allan variance of the two runs' (equal runs: equal EDF weights)
+        runs_avar = np.array([np.array(p["adev"][name]) ** 2 for p in d["per_run"]])
+        assert np.allclose(a**2, runs_avar.mean(axis=0), rtol=1e-9)
         # the curve floor (taus up to a tenth of the record, where the interval is tight) against
         # the datasheet's in-run bias stability, 0.007 deg/s = 25.2 deg/h
         reliable = np.array(d["tau"]) <= 1000.0
@@ -37,6 +40,8 @@ def test_allan_cli_on_real_adis16405_and_plan_from_it(tmp_path, run_cli):
 
     b = [pd.read_csv(p, usecols=["gyro_x_dps"])["gyro_x_dps"].mean() for p in runs]
     assert d["repeatability"]["gyro_x_dps"] == pytest.approx(abs(b[0] - b[1]) / np.sqrt(2), rel=1e-9)
+    assert [p["input"] for p in d["per_run"]] == [str(r) for r in runs] and "pooled" in d["adev_of"]
+    assert "pooled over 2 runs" in res.out and "run adis_16405_imu2.csv.gz" in res.out
     plan_out = tmp_path / "plan.json"
     res = run_cli("plan", "--rate", "100 deg/s", "--accuracy", "0.1 deg", "--allan", out, "--json", plan_out)
     assert res.code == 0, res.err
@@ -59,7 +64,8 @@ def test_allan_cli_bad_input(tmp_path, run_cli):
     assert res.code == 2 and "--units" in res.err
 
 
-#: every key an Allan file had before AllanJob became a registered result (a contract: add, never rename)
+#: every key an Allan file had before AllanJob became a registered result (a contract: add, never rename; the
+#: term names inside ``fit`` changed with version 2, and version 1 files still read)
 ALLAN_KEYS = {"format", "version", "generator", "units", "sensor", "fs_hz", "samples", "runs", "tau", "adev",
               "ci_low", "ci_high", "fit", "figures", "inputs", "adev_of", "mdev", "repeatability"}
 FIT_KEYS = {"method", "terms", "notes", "ieee_point_readouts", "continuous"}
@@ -94,7 +100,8 @@ def test_allan_job_round_trips_through_the_loader(tmp_path):
     assert ALLAN_KEYS | {"convention", "plan"} <= set(d)
     assert list(d)[:5] == ["format", "version", "generator", "convention", "units"]
     assert all(FIT_KEYS <= set(f) for f in d["fit"].values())
-    assert d["adev_of"] == "a.csv" and d["plan"]["format"] == "imu-align.plan"
+    assert d["adev_of"].startswith("pooled curve of 2 runs") and d["plan"]["format"] == "imu-align.plan"
+    assert d["version"] == 2 and [p["input"] for p in d["per_run"]] == ["a.csv", "b.csv"]
     assert approx_equal(AllanJob.from_dict(d), job, rtol=1e-12)
     path = tmp_path / "allan.json"
     save_result(path, job)
@@ -114,7 +121,9 @@ def test_accelerometer_job_round_trips_and_reads_older_files():
     job = _job("g", runs=1, modified=False)
     d = job.to_dict()
     assert d["sensor"] == "accelerometer" and "mdev" not in d and "repeatability" not in d
-    assert d["units"]["terms"]["flicker"] == "ug"
+    assert d["units"]["terms"]["bias_instability"] == "ug"
+    assert set(d["fit"]["x"]["terms"]) == {"quantization", "velocity_random_walk", "bias_instability",
+                                           "acceleration_random_walk", "acceleration_ramp"}
     assert approx_equal(AllanJob.from_dict(d), job, rtol=1e-12)
     for key in ("convention", "m", "periods_s", "adev_run_figures"):
         del d[key]

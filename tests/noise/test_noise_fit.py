@@ -25,7 +25,9 @@ def test_fit_recovers_simulated_arw_and_bias_instability_and_flags_rrw():
     for f in fits:
         assert f.identifiable[1]  # white
         assert not f.identifiable[3]  # rate random walk: not in the data, not identifiable
-        assert any(note.startswith("random_walk: not identifiable") and "h of record needed" in note for note in f.notes)
+        note = next(n for n in f.notes if n.startswith("random_walk (K): not identifiable"))
+        assert "h of record would identify" in note and np.isfinite(f.upper[3]) and f.upper[3] > 0
+        assert f.needed[3] > 1_000_000 / 100.0  # longer than this record
 
 
 def test_noise_figures_follow_seed_definitions():
