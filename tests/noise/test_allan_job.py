@@ -35,6 +35,10 @@ def test_allan_cli_on_real_adis16405_and_plan_from_it(tmp_path, run_cli):
         # the datasheet's in-run bias stability, 0.007 deg/s = 25.2 deg/h
         reliable = np.array(d["tau"]) <= 1000.0
         assert 15 < a[reliable].min() * 3600 < 50
+    # the floor readout is taken in the flat region (not at the last, wide tau): 26-30 deg/h for x (issue 13)
+    ro = d["fit"]["gyro_x_dps"]["ieee_point_readouts"]
+    assert 26 < 0.664 * ro["B_floor_over_0.664"] < 30 and ro["B_floor_tau_s"] < 0.3 * d["tau"][-1]
+    assert ro["B_floor_over_0.664_low"] < ro["B_floor_over_0.664"] < ro["B_floor_over_0.664_high"]
     # repeatability of two runs is |b1 - b2| / sqrt(2): check against the per-run means
     import pandas as pd
 
