@@ -6,6 +6,8 @@ in one run measures, each as a whole process (start-up, load, compute):
   2. `imu-align allan FILE.npy --rate-hz 2000 --columns x,y,z --json OUT` (default dense grid).
 Prints wall times, the ratio, peak RSS of each, and checks the two agree to 1e-10.
 Target (issue 5): at least 5x faster, peak memory under 2x the input array.
+Also the physical limit (issue 13): a process that reads the input once and makes one streaming pass
+over it per tau (a plain reduction, no arithmetic of the deviation), and our ratio to it.
 
     python bench/bench_allan.py [--samples 10000000] [--channels 3]
 """
@@ -37,13 +39,25 @@ for j in range(data.shape[1]):
 json.dump(out, open(sys.argv[3], "w"))
 """
 
+LIMIT = """
+import json, sys
+import numpy as np
+data = np.load(sys.argv[1])
+for _ in json.load(open(sys.argv[2]))["tau"]:
+    np.add.reduce(data, axis=0)   # one streaming pass over the whole record
+"""
+
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--samples", type=int, default=10_000_000)
     ap.add_argument("--channels", type=int, default=3)
     args = ap.parse_args()
-    folder = Path(tempfile.mkdtemp(prefix="imu_align_allan_"))
+    with tempfile.TemporaryDirectory(prefix="imu_align_allan_") as tmp:  # removed afterwards, also on a failure
+        run(args, Path(tmp))
+
+
+def run(args: argparse.Namespace, folder: Path) -> None:
     rng = np.random.default_rng(0)
     data = rng.standard_normal((args.samples, args.channels)) * 0.01
     data += np.cumsum(rng.standard_normal((args.samples, args.channels)), axis=0) * 1e-6
@@ -60,6 +74,9 @@ def main() -> None:
     anchor = folder / "anchor.py"
     anchor.write_text(ANCHOR)
     t_at, m_at = measure([sys.executable, str(anchor), str(npy), str(ours_json), str(theirs_json)])
+    limit = folder / "limit.py"
+    limit.write_text(LIMIT)
+    t_lim, _ = measure([sys.executable, str(limit), str(npy), str(ours_json)])
     ours = json.loads(ours_json.read_text())
     theirs = json.loads(theirs_json.read_text())
     worst = max(np.max(np.abs(np.array(theirs[str(j)]) / np.array(ours["adev"][f"c{j}"]) - 1)) for j in range(args.channels))
@@ -69,6 +86,8 @@ def main() -> None:
     print(f"imu-align allan         (whole process): {t_ours:7.2f} s   peak RSS {m_ours:7.0f} MB  "
           f"({m_ours / size_mb:.2f}x the input array)")
     print(f"speed-up: {t_at / t_ours:.1f}x   largest relative difference of the deviations: {worst:.2e}")
+    print(f"physical limit (read once + one streaming pass per tau, whole process): {t_lim:.2f} s; "
+          f"imu-align / limit = {t_ours / t_lim:.2f}")
     print("target: >= 5x faster, peak memory < 2x the input array")
 
 

@@ -48,15 +48,22 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--keep", type=Path, default=None, help="keep the generated session here")
     args = ap.parse_args()
-    folder = args.keep or Path(tempfile.mkdtemp(prefix="imu_align_bench_"))
-    folder.mkdir(parents=True, exist_ok=True)
+    if args.keep:
+        args.keep.mkdir(parents=True, exist_ok=True)
+        run(args, args.keep)
+        return
+    with tempfile.TemporaryDirectory(prefix="imu_align_bench_") as tmp:  # removed afterwards, also on a failure
+        run(args, Path(tmp))
+
+
+def run(args: argparse.Namespace, folder: Path) -> None:
     log, plan, rows = make_session(folder)
     size = log.stat().st_size / 1e6
     pandas_cmd = [sys.executable, "-c", f"import pandas as pd; df = pd.read_csv({str(log)!r}); print(len(df))"]
     ours_cmd = [sys.executable, "-m", "align.cli", "matrix", str(log), "--plan", str(plan), "--json", str(folder / "r.json")]
     t_pd, m_pd = measure(pandas_cmd, args.repeat)
     t_us, m_us = measure(ours_cmd, args.repeat)
-    print(f"session: {rows} rows, {size:.1f} MB CSV ({log})")
+    print(f"session: {rows} rows, {size:.1f} MB CSV")
     print(f"pandas.read_csv alone (whole process): {t_pd:6.3f} s   peak RSS {m_pd:7.1f} MB")
     print(f"imu-align matrix      (whole process): {t_us:6.3f} s   peak RSS {m_us:7.1f} MB")
     print(f"ratio imu-align / pandas read: {t_us / t_pd:.2f}  (target <= 2, and < 3 s)")
