@@ -221,13 +221,16 @@ class AllanResult(Value):
     adev : ndarray, shape (C, T)
     mdev : ndarray or None, shape (C, T)
     n : int
-        Samples per channel.
+        Samples per channel (of each run, for a pooled curve).
     fs : float
     names : tuple of str
     bias : ndarray, shape (C,)
         Mean of each channel (seed 002 Eq 5).
     stability : dict
         Period (s) -> ndarray (C,): bias stability (seed 002 Eq 7).
+    runs : int
+        Independent runs averaged into this curve (a pooled curve); the covariance of its points is that of one
+        run of ``n`` samples divided by ``runs``.
     alpha : ndarray of int or None, shape (C, T)
         Noise type identified at each tau: exponent of the rate PSD ``S ~ f^alpha``, 2 white PM /
         quantization, 1 flicker PM, 0 white FM / angle random walk, -1 flicker FM / bias instability,
@@ -252,6 +255,7 @@ class AllanResult(Value):
     alpha: np.ndarray | None = None
     edf: np.ndarray | None = None
     edf_mdev: np.ndarray | None = None
+    runs: int = 1
 
     def __post_init__(self) -> None:
         super().__post_init__()

@@ -171,7 +171,7 @@ def fit_noise(res: AllanResult, channel: int, min_edf: float = 2.0, where: str |
     use = np.flatnonzero((edf >= min_edf) & (avar > 0))
     pick = use[np.unique(np.round(np.linspace(0, len(use) - 1, min(FIT_POINTS, len(use)))).astype(int))]
     a, y = avar_design(tau[pick]), avar[pick]
-    gls = GlsFit(a, y, avar_covariance_basis(res.m[pick], res.n_phase, res.fs),
+    gls = GlsFit(a, y, avar_covariance_basis(res.m[pick], res.n_phase, res.fs) / res.runs,
                  2 * np.maximum(a @ p, y) ** 2 / np.maximum(edf[pick], 1.0))
     p, cov, _ = gls.solve(p, ITERATIONS)
     params = np.sqrt(p)
@@ -185,10 +185,10 @@ def fit_noise(res: AllanResult, channel: int, min_edf: float = 2.0, where: str |
     edf_all, dominant = _point_edf(res, channel, p)
     for k in np.flatnonzero(~ident):
         upper[k] = _upper(k, p, tau[use], avar[use], edf_all[use])
-        needed[k] = _needed(k, upper[k], p, res)
-        notes.append(_note(k, p[k], share[k], rel[k], needed[k], res))
+        needed[k], here = _needed(k, upper[k], p, res)
+        notes.append(_note(k, p[k], share[k], rel[k], needed[k], res, here))
     lo, hi = _interval(res, channel, adev, edf)
-    readouts = point_readouts(tau, adev, edf_all, lambda idx: avar_covariance(res.m[idx], res.n_phase, res.fs, params),
+    readouts = point_readouts(tau, adev, edf_all, lambda idx: avar_covariance(res.m[idx], res.n_phase, res.fs, params) / res.runs,
                               params)
     return NoiseFit(params, sigma, tuple(bool(i) for i in ident), tuple(notes), dominant, edf_all, lo, hi, readouts,
                     cov, upper, needed)
@@ -209,12 +209,13 @@ def _upper(k: int, p: np.ndarray, tau: np.ndarray, avar: np.ndarray, edf: np.nda
     return float(np.sqrt(np.min(top / avar_design(tau)[:, k])))
 
 
-def _identifiable_at(k: int, p: np.ndarray, n: float, fs: float) -> bool:
-    """Whether term ``k`` of the squared parameters ``p`` is identifiable from an ``n``-sample record at ``fs``."""
+def _identifiable_at(k: int, p: np.ndarray, n: float, fs: float, runs: int = 1) -> bool:
+    """Whether term ``k`` of the squared parameters ``p`` is identifiable from ``runs`` records of ``n`` samples at
+    ``fs``."""
     m = tau_grid(int(n), fs, "dense", per_decade=2).astype(float)
     a = avar_design(m / fs)
     cols = np.flatnonzero(p > 0)
-    s = avar_covariance(m, n + 1, fs, np.sqrt(p), lags=32)
+    s = avar_covariance(m, n + 1, fs, np.sqrt(p), lags=32) / runs
     wh = whitener(s, np.diag(s) + 1e-300)
     aw = wh @ a[:, cols]
     var = np.linalg.pinv(aw.T @ aw)[list(cols).index(k), list(cols).index(k)]
@@ -223,39 +224,49 @@ def _identifiable_at(k: int, p: np.ndarray, n: float, fs: float) -> bool:
     return bool(share >= 0.3 and np.sqrt(max(var, 0.0)) / (2 * p[k]) < 0.25)
 
 
-def _needed(k: int, bound: float, p: np.ndarray, res: AllanResult) -> float:
-    """Record length (s; sample rate, Hz, for Q and N) at which a term ``k`` of size ``bound`` would be identifiable."""
+def _needed(k: int, bound: float, p: np.ndarray, res: AllanResult) -> tuple[float, bool]:
+    """Record length (s; sample rate, Hz, for Q and N) at which a term ``k`` of size ``bound`` would be identifiable,
+    and whether a term that size would already be identified from this record (then the term is smaller than the
+    bound, and no length can be named: NaN)."""
     if not bound > 0:
-        return float("nan")
+        return float("nan"), False
     q = p.copy()
     q[k] = bound**2
     rate = TERMS[k] in ("quantization", "white")
-    scale = (lambda j: (res.n * 2.0**j, res.fs * 2.0**j)) if rate else (lambda j: (res.n * 2.0**j, res.fs))
+    scale = ((lambda j: (res.n * 2.0**j, res.fs * 2.0**j, res.runs)) if rate
+             else (lambda j: (res.n * 2.0**j, res.fs, res.runs)))
+    if _identifiable_at(k, q, *scale(0)):
+        return float("nan"), True
     lo, hi = 0, 16
     if not _identifiable_at(k, q, *scale(hi)):
-        return float("nan")
+        return float("nan"), False
     while hi - lo > 1:
         mid = (lo + hi) // 2
         lo, hi = (lo, mid) if _identifiable_at(k, q, *scale(mid)) else (mid, hi)
-    n, fs = scale(hi)
-    return fs if rate else n / fs
+    n, fs, _ = scale(hi)
+    return (fs if rate else n / fs), False
 
 
-def _note(k: int, pk: float, share: float, rel: float, needed: float, res: AllanResult) -> str:
+def _note(k: int, pk: float, share: float, rel: float, needed: float, res: AllanResult, here: bool = False) -> str:
     """Why term ``k`` is not identifiable and what would make it so (values live in ``upper``/``needed``)."""
     term, hours = TERMS[k], res.n / res.fs / 3600
+    record = f"this {hours:.3g} h record" if res.runs == 1 else f"these {res.runs} runs of {hours:.3g} h"
+    per = "" if res.runs == 1 else " per run"
     if pk <= 0:
         why = "fitted as zero"
     elif share < 0.3:
         why = f"at most {100 * share:.0f} % of the curve at any tau"
     else:
         why = f"1-sigma {100 * rel:.0f} %"
-    head = f"{term} ({LETTERS[term]}): not identifiable from this {hours:.3g} h record ({why}); 95 % upper bound given"
+    head = f"{term} ({LETTERS[term]}): not identifiable from {record} ({why}); 95 % upper bound given"
+    if here:
+        return head + (f"; a term as large as the bound would show in {'this record' if res.runs == 1 else 'these runs'}"
+                       ", so it is smaller: how much longer or faster a record must be to identify it is not known")
     if not np.isfinite(needed):
         return head + "; no record up to 65536 times longer or faster would identify a term that size"
     if term in ("quantization", "white"):
         return head + f"; a sample rate of about {needed:.3g} Hz would identify a term that size"
-    return head + f"; about {needed / 3600:.3g} h of record would identify a term that size"
+    return head + f"; about {needed / 3600:.3g} h of record{per} would identify a term that size"
 
 
 def _check_fittable(res: AllanResult, channel: int, use: np.ndarray, where: str | None) -> None:

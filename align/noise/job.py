@@ -63,7 +63,7 @@ class AllanJob(Result, format=FORMAT, convention=CONVENTION, version=2):
     ----------
     result : AllanResult
         The curve fitted: the Allan deviation of the one run, or the pooled curve of several
-        (:func:`pool_runs`; ``n`` the samples of all runs; no bias figures), SI.
+        (:func:`pool_runs`; ``n`` the samples of the shortest run, ``runs`` their number; no bias figures), SI.
     fits : tuple of NoiseFit
         One per channel, of ``result``.
     figures : tuple of dict
@@ -157,6 +157,9 @@ class AllanJob(Result, format=FORMAT, convention=CONVENTION, version=2):
             figures = tuple(jf.read_figures(d["figures"][k], periods, f) for k in names)
             run = d.get("adev_run_figures", d["figures"] if runs == 1 else None)
             result, fits = jf.read_curve(d, tau, m, n, fs, names, f, tu, run, periods)
+            if d.get("per_run"):  # the pooled curve: ``samples`` of the shortest run (version 2 files before this
+                #                    said all runs' samples: the per-run records tell)
+                result = result.replace(n=min(int(p["samples"]) for p in d["per_run"]), runs=len(d["per_run"]))
             per = [jf.read_curve(p, tau, m, int(p["samples"]), fs, names, f, tu, p["figures"], periods)
                    for p in d.get("per_run", ())]
             rep = d.get("repeatability")
@@ -186,9 +189,9 @@ def pool_runs(results: list[AllanResult], edfs: list[np.ndarray]) -> AllanResult
         / NIST SP 1065 Eq 14 summed over runs, none across a run boundary), the plain mean for runs of equal
         length; its EDF is ``sum_k nu_k`` (independent runs: their chi-square degrees of freedom add, NIST
         SP 1065 section 5.3). The modified deviation is pooled the same way with ``N_k - 3m + 1``.
-        ``n`` is the samples of all runs (the covariance of its points is about that of one record that long);
-        no bias figures. Its ``edf`` (and ``edf_mdev``) is the sum of the runs', its ``alpha`` the first run's
-        noise types.
+        ``n`` is the samples of the shortest run and ``runs`` their number (the covariance of its points is that
+        of one such run divided by the number of runs: conservative for unequal runs); no bias figures. Its
+        ``edf`` (and ``edf_mdev``) is the sum of the runs', its ``alpha`` the first run's noise types.
     """
     first = results[0]
     m = first.m.astype(float)
@@ -199,7 +202,8 @@ def pool_runs(results: list[AllanResult], edfs: list[np.ndarray]) -> AllanResult
     if all(r.mdev is not None for r in results):
         wm = np.stack([np.broadcast_to(np.maximum(r.n_phase - 3 * m + 1, 0), r.adev.shape) for r in results])
         mdev = np.sqrt(np.sum(wm * np.stack([r.mdev**2 for r in results]), axis=0) / np.sum(wm, axis=0))
-    res = AllanResult(first.tau, first.m, np.sqrt(pooled), mdev, int(sum(r.n for r in results)), first.fs, first.names)
+    res = AllanResult(first.tau, first.m, np.sqrt(pooled), mdev, int(min(r.n for r in results)), first.fs, first.names,
+                      runs=len(results))
     fields = {fl.name for fl in dataclasses.fields(AllanResult)}
     extra = {}
     if "edf" in fields:

@@ -94,9 +94,12 @@ def test_short_records_bound_what_they_cannot_identify(short_records):
             continue
         # a bound, not a value: above the truth, of the truth's order (never "K < 3e-152"), and a longer record named
         assert K <= f.upper[3] < 30 * K
-        assert f.needed[3] > hours * 3600
         note = next(n for n in f.notes if n.startswith("random_walk (K): not identifiable"))
-        assert "95 % upper bound" in note and "h of record would identify" in note
+        assert "95 % upper bound" in note
+        # either a longer record is named (the search starts at this record's length, so it may be 1x: it is not)
+        # or a term at the bound would already show here (then the term is smaller and no length is named)
+        assert (f.needed[3] > hours * 3600 and "h of record would identify" in note) or (
+            np.isnan(f.needed[3]) and "would show in this record" in note)
     assert sum(not f.identifiable[3] for f in fits) >= 15
 
 
