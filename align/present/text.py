@@ -196,6 +196,24 @@ def _fit_lines(fit: dict) -> list[str]:
     return lines
 
 
+def _noise_types(tau: list[float], alpha: list[int], sensor: str) -> str:
+    """``"N angle random walk 0.01-12.6 s; B bias instability 15.8-398 s"``: the power-law noise identified per
+    range of tau (alpha 2 Q, 0 N, -1 B, -2 K; alpha 1, flicker phase noise, has no IEEE 952 term)."""
+    from align.noise.model import term
+
+    keys = {2: "quantization", 0: "white", -1: "flicker", -2: "random_walk"}
+    parts, start = [], 0
+    for k in range(1, len(alpha) + 1):
+        if k == len(alpha) or alpha[k] != alpha[start]:
+            a = int(alpha[start])
+            what = (f"{term(keys[a]).symbol} {term(keys[a]).name(sensor)}" if a in keys
+                    else "alpha 1 (between Q and N)")
+            span = f"{tau[start]:.3g}" + (f"-{tau[k - 1]:.3g}" if k - 1 > start else "")
+            parts.append(f"{what} {span} s")
+            start = k
+    return "; ".join(parts)
+
+
 def allan_summary(job: AllanJob) -> str:
     """The table ``imu-align allan`` prints (values in the job's file units, terms in engineering units).
 
@@ -219,6 +237,9 @@ def allan_summary(job: AllanJob) -> str:
     for name, fit in d["fit"].items():
         lines.append(f"  {name}" + (" (pooled curve)" if job.pooled else ""))
         lines += _fit_lines(fit)
+        if d.get("noise_type_alpha"):
+            lines.append("    noise type by tau (lag-1 autocorrelation, B1 ratio): "
+                         + _noise_types(tau, d["noise_type_alpha"][name], job.sensor))
         fig = d["figures"][name]
         stab = ", ".join(f"{p}: {v:.4g}" for p, v in fig["bias_stability"].items())
         lines.append(f"    bias {fig['bias']:.6g} {u['bias']}; bias stability ({stab}) {u['bias']}")

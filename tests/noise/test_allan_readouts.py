@@ -155,3 +155,19 @@ def test_planner_has_no_floor_for_white_noise_alone(run_cli, tmp_path):
     res = run_cli("plan", "--rate", "100 deg/s", "--accuracy", "0.1 deg", "--arw", "0.3 deg/sqrt(h)",
                   "--bias-instability", "5 deg/h")
     assert "3.321 deg/h (0.664 B, approached as tau grows)" in res.out
+
+
+def test_summary_names_the_noise_identified_at_each_tau():
+    """White rate noise alone (generated here, not by the code under test) reads as N over the mid taus, in the
+    IEEE letters and the gyro's words (issue 13: the identified noise type per tau is reported)."""
+    from align.noise.job import run_allan
+    from align.present.text import allan_summary
+
+    rng = np.random.default_rng(3)
+    job = run_allan([rng.standard_normal((50_000, 1)) * 0.01], 100.0, ["x"], "deg/s")
+    line = next(ln for ln in allan_summary(job).splitlines() if "noise type by tau" in ln)
+    spans = line.split(": ", 1)[1].split("; ")
+    widest = max(spans, key=lambda p: float(p.rsplit(" ", 1)[0].split()[-1].split("-")[-1])
+                 / float(p.rsplit(" ", 1)[0].split()[-1].split("-")[0]))
+    assert widest.startswith("N angle random walk 0.01-")  # from the shortest tau over the widest span
+    assert "white" not in line and "flicker" not in line
