@@ -86,7 +86,7 @@ def matrix(
     result = align(t, g, the_plan, opts, segs, got.shown, str(log))
     result = result.replace(inputs={"log": str(log), "plan": str(plan), "gyro_units": gyro_units, "columns": columns,
                                     "segments": None if segments is None else str(segments), **got.inputs()},
-                            notes=result.notes + ((got.time_note(),) if got.time_note() else ()))
+                            notes=result.notes + tuple(filter(None, [got.time_note()])))
     with outputs() as out:  # all or none
         if json_out is not None:
             out.write_json(json_out, result)

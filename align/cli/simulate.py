@@ -69,13 +69,10 @@ def _unit_axis(text: str) -> tuple[float, float, float]:
 
 
 def _rotation_rows(angle: float, axis: tuple[float, float, float]) -> tuple[tuple[float, float, float], ...]:
-    """``N = Rot(axis, angle)^T`` (Rodrigues): row ``i`` is gyro ``i``'s axis, ``Rot e_i``, in the system frame."""
-    c, s = math.cos(angle), math.sin(angle)
-    x, y, z = axis
-    r = [[c + x * x * (1 - c), x * y * (1 - c) - z * s, x * z * (1 - c) + y * s],
-         [y * x * (1 - c) + z * s, c + y * y * (1 - c), y * z * (1 - c) - x * s],
-         [z * x * (1 - c) - y * s, z * y * (1 - c) + x * s, c + z * z * (1 - c)]]
-    return tuple((r[0][i], r[1][i], r[2][i]) for i in range(3))
+    """``N = Rot(axis, angle)^T`` (:func:`align.alignment.simulate.mounting_from_rotation`) as rows."""
+    from align.alignment.simulate import mounting_from_rotation
+
+    return tuple(tuple(float(v) for v in row) for row in mounting_from_rotation(angle, axis))
 
 
 def parse_mounting_option(text: str) -> MountingOption:

@@ -52,8 +52,6 @@ FIT_METHOD = ("generalised least squares on the overlapping Allan variance with 
 FIT_POINTS = 16
 #: refits with the covariance of the previous fit
 ITERATIONS = 3
-#: one-sided level of the upper bounds of terms that are not identifiable
-UPPER_LEVEL = 0.95
 #: one-sided level of each point's bound behind them (the minimum over several points: about 95 % overall)
 POINT_LEVEL = 0.99
 #: the IEEE letter of each term
@@ -128,13 +126,6 @@ def _point_edf(res: AllanResult, channel: int, p: np.ndarray) -> tuple[np.ndarra
     return edf_overlapping(res.n_phase, res.m, np.array([NOISE_ALPHA[d] for d in dominant])), dominant
 
 
-def _interval(res: AllanResult, channel: int, adev: np.ndarray, edf: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    if hasattr(res, "interval"):
-        lo, hi = res.interval()
-        return np.asarray(lo)[channel], np.asarray(hi)[channel]
-    return confidence_interval(adev, edf)
-
-
 def fit_noise(res: AllanResult, channel: int, min_edf: float = 2.0, where: str | None = None) -> NoiseFit:
     """Fit the five-term model to one channel of an :class:`AllanResult` (module docstring: GLS, bounds).
 
@@ -187,7 +178,7 @@ def fit_noise(res: AllanResult, channel: int, min_edf: float = 2.0, where: str |
         upper[k] = _upper(k, p, tau[use], avar[use], edf_all[use])
         needed[k], here = _needed(k, upper[k], p, res)
         notes.append(_note(k, p[k], share[k], rel[k], needed[k], res, here))
-    lo, hi = _interval(res, channel, adev, edf)
+    lo, hi = confidence_interval(adev, edf)  # the channel's EDF: the result's own (per-tau identification)
     readouts = point_readouts(tau, adev, edf_all, lambda idx: avar_covariance(res.m[idx], res.n_phase, res.fs, params) / res.runs,
                               params)
     return NoiseFit(params, sigma, tuple(bool(i) for i in ident), tuple(notes), dominant, edf_all, lo, hi, readouts,

@@ -142,8 +142,7 @@ def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Pa
         got = read_sensor_log(src(log), ["gyro_x", "gyro_y", "gyro_z"], gyro_units, log_format=log_format)
         t, g = got.t, got.data
         r = align(t, g, the_plan, units=got.shown, where=str(log))
-        if got.time_note():
-            r = r.replace(notes=r.notes + (got.time_note(),))
+        r = r.replace(notes=r.notes + tuple(filter(None, [got.time_note()])))
         sections.append(report.alignment_section(r, segmentation_plot_png(t, g, r, r.units)))
         inputs["rate-table log"] = (str(log), "")
         inputs["plan"] = (str(plan), _text(src(plan)))

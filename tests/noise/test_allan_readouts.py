@@ -62,8 +62,7 @@ def test_pooled_curve_is_the_mean_allan_variance_with_summed_edf():
     assert np.allclose(to_unit(r.adev[0], "deg/s") ** 2, np.mean(avars, axis=0), rtol=1e-9)
     assert job.pooled and len(job.run_results) == 2 and len(job.run_fits) == 2
     assert np.array_equal(job.run_results[0].m, r.m)
-    if getattr(r, "edf", None) is not None:
-        assert np.allclose(r.edf, job.run_results[0].edf + job.run_results[1].edf)
+    assert np.allclose(r.edf, job.run_results[0].edf + job.run_results[1].edf)
     d = job.to_dict()
     assert "pooled" in d and len(d["per_run"]) == 2 and d["adev_of"].startswith("pooled curve of 2 runs")
     back = AllanJob.from_dict(json.loads(json.dumps(d)))

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from align.noise.allan import allan, confidence_interval
+from align.noise.allan import allan
 from align.noise.identify import alpha_from_b1, alpha_from_lag1, b1_theory, edf_greenhall, noise_type_name
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "stable32"
@@ -125,7 +125,11 @@ def test_result_interface_and_coverage_of_the_68_percent_interval():
     assert r.alpha.shape == r.adev.shape and r.alpha.dtype.kind == "i" and set(np.unique(r.alpha)) <= {2, 1, 0, -1, -2}
     assert np.all(np.isfinite(r.edf)) and np.all(r.edf > 0) and np.all(np.isfinite(r.edf_mdev) == np.isfinite(r.mdev))
     lo, hi = r.interval()
-    assert np.array_equal((lo, hi), confidence_interval(r.adev, r.edf))
+    from scipy.stats import chi2  # independent of the code's gammaincinv: dev sqrt(edf / chi2_q(edf)) (SP 1065 5.3.3)
+
+    q = 0.682689492137086
+    assert np.allclose(lo, r.adev * np.sqrt(r.edf / chi2.ppf(0.5 + q / 2, r.edf)), rtol=1e-9)
+    assert np.allclose(hi, r.adev * np.sqrt(r.edf / chi2.ppf(0.5 - q / 2, r.edf)), rtol=1e-9)
     s = r.scaled(3.0)
     assert np.array_equal(s.alpha, r.alpha) and np.allclose(s.interval()[1], 3 * hi)
     assert allan(y, 10.0, deviations=False).alpha is None
