@@ -25,8 +25,11 @@ progress   the progress bar of long jobs
 alignment  matrix, apply, simulate
 mechanics  budget, allowable, check
 noise      allan, plan
+parts      parts
+navigation drift
 story      report, demo
-calibrate  calibrate ferraris | accel | mag
+exports    export
+calibrate  calibrate ferraris | accel | mag | gyro
 """
 
 from __future__ import annotations
@@ -39,7 +42,7 @@ from typing import Annotated
 import typer
 
 from align import __version__
-from align.cli import alignment, calibrate, mechanics, noise, simulate, story
+from align.cli import alignment, calibrate, exports, mechanics, navigation, noise, parts, simulate, story
 from align.cli.options import rewrite_aliases, speller
 
 PROG = "imu-align"
@@ -68,14 +71,15 @@ def _root(
     pass
 
 
-for _module in (alignment, simulate, mechanics, noise, story):
+_MODULES = (alignment, simulate, mechanics, parts, noise, navigation, story, exports)
+for _module in _MODULES:
     for _name, _command in _module.COMMANDS.items():
         app.command(_name)(_command)
 app.add_typer(calibrate.app, name="calibrate")
 
 #: command -> its subcommands (empty: a command)
 COMMANDS: dict[str, tuple[str, ...]] = {
-    **{name: () for m in (alignment, simulate, mechanics, noise, story) for name in m.COMMANDS},
+    **{name: () for m in _MODULES for name in m.COMMANDS},
     "calibrate": tuple(calibrate.COMMANDS),
 }
 
