@@ -29,6 +29,7 @@ parts      parts
 navigation drift
 story      report, demo
 exports    export
+batch      batch, lot
 calibrate  calibrate ferraris | accel | mag | gyro
 """
 
@@ -42,7 +43,7 @@ from typing import Annotated
 import typer
 
 from align import __version__
-from align.cli import alignment, calibrate, exports, mechanics, navigation, noise, parts, simulate, story
+from align.cli import alignment, batch, calibrate, exports, mechanics, navigation, noise, parts, simulate, story
 from align.cli.options import rewrite_aliases, speller
 
 PROG = "imu-align"
@@ -71,7 +72,7 @@ def _root(
     pass
 
 
-_MODULES = (alignment, simulate, mechanics, parts, noise, navigation, story, exports)
+_MODULES = (alignment, simulate, mechanics, parts, noise, navigation, story, exports, batch)
 for _module in _MODULES:
     for _name, _command in _module.COMMANDS.items():
         app.command(_name)(_command)
