@@ -5,17 +5,37 @@ figure was not read from the datasheet itself (a secondary source, a typical
 value of the family, or a cross-axis sensitivity standing in for a missing
 axis-to-package figure). Look a part up with :func:`get_part`.
 
+A user's own parts (parsed TOML, the same fields as the built-in table: one table
+per part, each figure a quantity string or ``{value, source, confirmed}``) are read
+with :func:`parts_from_dict` and laid over the built-in table with :func:`merge_parts`:
+a new name adds a part, a preset's name replaces the figures it gives (the others stay).
+Nothing here reads a file or the environment: the caller passes the parsed table.
+
 Public names
 ------------
-Part, PARTS, get_part
+Figure, Part, PARTS, FIGURES, PART_KEYS, KINDS, get_part, find_part, parts_from_dict, merge_parts
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import difflib
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
 
-from align.errors import InputError
+from align.errors import InputError, literal
 from align.units import parse_quantity
+
+#: every figure a part may state -> its dimension (a key of :data:`align.units.DIMENSIONS`), in listing order
+FIGURES: dict[str, str] = {
+    "axis_to_package": "angle", "axis_to_axis": "angle", "arw": "angle_random_walk",
+    "noise_density": "angle_random_walk", "bias_instability": "angular_rate",
+    "package_x": "length", "package_y": "length", "hole_spacing_x": "length", "hole_spacing_y": "length",
+}
+#: the kinds of part
+KINDS = ("module", "chip")
+#: the keys of one part's table in a parts file
+PART_KEYS = ("kind", *FIGURES)
 
 
 @dataclass(frozen=True)
@@ -46,7 +66,7 @@ class Part:
     name : str
         Part number, e.g. ``"ADIS16485"``.
     kind : str
-        ``"module"`` (a packaged IMU with mounting holes) or ``"chip"``.
+        ``"module"`` (a packaged IMU with mounting holes) or ``"chip"``; empty when a parts file does not say.
     package_x, package_y : Figure or None
         Package length ``L`` and width ``W`` (Eq 2-3, Example 1), a length.
     hole_spacing_x, hole_spacing_y : Figure or None
@@ -104,11 +124,21 @@ class Part:
             "confirmed"}`` (the value keeps its unit string).
         """
         out = {"name": self.name, "kind": self.kind}
-        for key in ("package_x", "package_y", "hole_spacing_x", "hole_spacing_y", "axis_to_package",
-                    "axis_to_axis", "arw", "bias_instability", "noise_density"):
-            fig = getattr(self, key)
+        out.update(self.provenance(name for name, _ in self.figures()))
+        return out
+
+    def figures(self) -> list[tuple[str, Figure]]:
+        """The figures the part states, in the order of :data:`FIGURES`."""
+        return [(name, getattr(self, name)) for name in FIGURES if getattr(self, name) is not None]
+
+    def provenance(self, names) -> dict:
+        """``{figure: {"value", "source", "confirmed"}}`` for the figures ``names`` the part states: what a
+        result records of the preset values it used (absent figures are left out)."""
+        out = {}
+        for name in names:
+            fig = getattr(self, name)
             if fig is not None:
-                out[key] = {"value": fig.value, "source": fig.source, "confirmed": fig.confirmed}
+                out[name] = {"value": fig.value, "source": fig.source, "confirmed": fig.confirmed}
         return out
 
 
@@ -166,7 +196,16 @@ PARTS: dict[str, Part] = {p.name: p for p in (
 )}
 
 
-def get_part(name: str, where: str = "imu.part") -> Part:
+def find_part(name: str, table: Mapping[str, Part] | None = None) -> Part | None:
+    """The part named ``name`` (case-insensitive) in ``table`` (default :data:`PARTS`), or None."""
+    wanted = str(name).strip().lower()
+    for key, part in (PARTS if table is None else table).items():
+        if key.lower() == wanted:
+            return part
+    return None
+
+
+def get_part(name: str, where: str = "imu.part", table: Mapping[str, Part] | None = None) -> Part:
     """Look up a preset by name (case-insensitive); an unknown name lists the known ones.
 
     Parameters
@@ -175,6 +214,8 @@ def get_part(name: str, where: str = "imu.part") -> Part:
         Part number, e.g. ``"adis16485"``.
     where : str
         The file field or input the name came from, for the error message.
+    table : mapping of str to Part, optional
+        The parts to look in (:func:`merge_parts` of a user's file); default :data:`PARTS`.
 
     Returns
     -------
@@ -183,9 +224,110 @@ def get_part(name: str, where: str = "imu.part") -> Part:
     Raises
     ------
     InputError
-        For a name that is not in :data:`PARTS`.
+        For a name that is not in the table (naming the nearest and the known parts, and the parts file
+        that would add it, ``{parts}``).
     """
-    for key, part in PARTS.items():
-        if key.lower() == str(name).strip().lower():
-            return part
-    raise InputError(f"unknown part '{name}'; known parts: {', '.join(PARTS)}", where)
+    table = PARTS if table is None else table
+    part = find_part(name, table)
+    if part is None:
+        near = difflib.get_close_matches(str(name).upper(), [k.upper() for k in table], n=1, cutoff=0.6)
+        hint = f"did you mean '{next(k for k in table if k.upper() == near[0])}'? " if near else ""
+        raise InputError(f"unknown part '{literal(name)}' ({hint}known parts: {', '.join(table)}); add it to a "
+                         "parts file ({parts})", where)
+    return part
+
+
+def _figure(raw, name: str, here: str, origin: str) -> Figure:
+    """One figure of a parts file: ``"1 deg"`` or ``{value = "1 deg", source = "...", confirmed = true}``;
+    ``here`` names the field, ``origin`` the file (recorded in the figure's source)."""
+    if isinstance(raw, Mapping):
+        unknown = [k for k in raw if k not in ("value", "source", "confirmed")]
+        if unknown:
+            raise InputError(f"unknown key '{literal(unknown[0])}' (known: value, source, confirmed)", here)
+        if "value" not in raw:
+            raise InputError(f"missing key 'value' (e.g. {name} = {{{{ value = \"{_EXAMPLE[FIGURES[name]]}\", "
+                             "source = \"datasheet rev A\", confirmed = true }})", here)
+        value, source, confirmed = raw["value"], raw.get("source"), raw.get("confirmed", False)
+        if source is not None and not (isinstance(source, str) and source.strip()):
+            raise InputError("source must be a non-empty string (where the figure comes from)", f"{here}.source")
+        if not isinstance(confirmed, bool):
+            raise InputError(f"confirmed must be true or false, not {literal(repr(confirmed))}", f"{here}.confirmed")
+    else:
+        value, source, confirmed = raw, None, False
+    if not isinstance(value, str):
+        raise InputError(f"give the value with its unit as a string, e.g. {name} = \"{_EXAMPLE[FIGURES[name]]}\" "
+                         f"(got {literal(repr(value))})", here)
+    si = parse_quantity(value, FIGURES[name], here)
+    if not (math.isfinite(si) and si > 0):
+        raise InputError(f"must be finite and > 0 (got '{literal(value)}')", here)
+    return Figure(value.strip(), origin if source is None else f"{source.strip()} ({origin})", confirmed)
+
+
+_EXAMPLE = {"angle": "1 deg", "angle_random_walk": "0.3 deg/sqrt(h)", "angular_rate": "6 deg/h", "length": "44 mm"}
+
+
+def parts_from_dict(data: Mapping, where: str = "parts") -> dict[str, Part]:
+    """A user's parts file (parsed TOML): one table per part, the fields of :class:`Part`.
+
+    ``[MY-IMU]`` with ``kind = "module"`` (or ``"chip"``) and any figures of :data:`FIGURES`,
+    each a quantity string (source: the file, not confirmed) or a table
+    ``{value = "0.5 deg", source = "datasheet rev B, table 2", confirmed = true}``.
+    Every value is checked for its dimension and for being finite and > 0.
+
+    Parameters
+    ----------
+    data : mapping
+        The parsed file.
+    where : str
+        The file's name, for messages and for the figures' source.
+
+    Returns
+    -------
+    dict of str to Part
+        The parts as the file gives them (a preset's name may give only some figures: see :func:`merge_parts`).
+
+    Raises
+    ------
+    InputError
+        A part that is not a table, an unknown key (with the nearest known one), a kind that is not
+        :data:`KINDS`, a value without a unit, of the wrong dimension, zero or negative.
+    """
+    if not data:
+        raise InputError("holds no part; give one table per part, e.g. [MY-IMU] with axis_to_package = \"0.5 deg\"",
+                         where)
+    out: dict[str, Part] = {}
+    for name, t in data.items():
+        here = f"{where}: [{name}]"
+        if not isinstance(t, Mapping):
+            raise InputError(f"'{literal(name)}' must be a table of figures ([{literal(name)}] with "
+                             "axis_to_package = \"0.5 deg\", ...), not a single value", where)
+        for key in t:
+            if key not in PART_KEYS:
+                near = difflib.get_close_matches(str(key), PART_KEYS, n=1, cutoff=0.6)
+                hint = f"did you mean '{near[0]}'? " if near else ""
+                raise InputError(f"unknown key '{literal(key)}' ({hint}known: {', '.join(PART_KEYS)})", here)
+        kind = t.get("kind", "")
+        if kind and kind not in KINDS:
+            raise InputError(f"kind '{literal(kind)}' is not one of {', '.join(KINDS)}", f"{where}: {name}.kind")
+        figs = {k: _figure(t[k], k, f"{where}: {name}.{k}", f"user parts file {where}") for k in FIGURES if k in t}
+        if not figs:
+            raise InputError(f"gives no figure; give at least one of {', '.join(FIGURES)}", here)
+        out[str(name).strip()] = Part(str(name).strip(), kind, **figs)
+    return out
+
+
+def merge_parts(user: Mapping[str, Part], base: Mapping[str, Part] | None = None) -> dict[str, Part]:
+    """``base`` (default :data:`PARTS`) extended and overridden by ``user``.
+
+    A user part whose name is a preset's (case-insensitive) replaces the figures it gives and keeps the
+    preset's others (and its name and, unless given, its kind); any other name is a new part.
+    """
+    table = dict(PARTS if base is None else base)
+    for name, part in user.items():
+        old = find_part(name, table)
+        if old is None:
+            table[name] = part
+            continue
+        figs = {k: f for k, f in part.figures()}
+        table[old.name] = replace(old, kind=part.kind or old.kind, **figs)
+    return table

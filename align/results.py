@@ -49,6 +49,7 @@ KNOWN: dict[str, str] = {
     "imu-align.allowable": "align.sensitivity.allowable",
     "imu-align.check": "align.sensitivity.margins",
     "imu-align.budget": "mechanics.budget",
+    "imu-align.drift": "align.navigation.result",
 }
 
 _TYPES: dict[str, type[Result]] = {}

@@ -18,7 +18,7 @@ import numpy as np
 
 from align.errors import InputError, literal
 from align.io.keys import check_keys, file_name, referenced_file, table
-from align.parts import get_part
+from align.parts import Part, find_part, get_part
 from align.units import DEG, parse_quantity
 from align.values import Value
 from mechanics.formulas import screw_radius
@@ -54,6 +54,12 @@ class Mount(Value):
     distributions : dict
         ``{"imu": ..., "ledges": ..., "extras": ...}``, each "uniform" or "normal"
         (normal: the band or bound is +/- 3 sigma).
+    part : str or None
+        The part the ``[imu]`` table names: a preset, or a label (a name that is not a preset, its
+        values all given in the file).
+    preset : dict
+        The preset values the mount uses, ``{figure: {"value", "source", "confirmed"}}`` (empty for a label,
+        for no part, or when the file gives every value itself).
     """
 
     axis_to_package: np.ndarray
@@ -71,6 +77,7 @@ class Mount(Value):
     distributions: dict = field(default_factory=lambda: {"imu": "uniform", "ledges": "uniform", "extras": "uniform"})
     part: str | None = None
     baseplate: str | None = None
+    preset: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         for name in ("axis_to_package", "package", "pad_heights"):
@@ -99,7 +106,7 @@ class Mount(Value):
             "screw_radius_mm": screw_radius(self.spacing_x, self.spacing_y) * 1e3,
             "position_tolerance_mm": self.position_tolerance * 1e3,
             "extras_deg": {k: v / DEG for k, v in self.extras.items()}, "distributions": dict(self.distributions),
-            "baseplate": self.baseplate,
+            "baseplate": self.baseplate, "preset": {k: dict(v) for k, v in self.preset.items()},
             "pads_mm": (self.pads * 1e3).tolist(), "pad_heights_mm": (self.pad_heights * 1e3).tolist(),
         }
 
@@ -120,7 +127,7 @@ class Mount(Value):
                        float(d["hole_diameter_mm"]) * 1e-3, spacing[0], spacing[1],
                        float(d.get("position_tolerance_mm", 0.0)) * 1e-3,
                        {k: float(v) * DEG for k, v in d.get("extras_deg", {}).items()},
-                       dict(d["distributions"]), d.get("part"), d.get("baseplate"))
+                       dict(d["distributions"]), d.get("part"), d.get("baseplate"), dict(d.get("preset") or {}))
         except (KeyError, TypeError, ValueError, IndexError) as exc:
             raise InputError(f"malformed mount ({literal(repr(exc))})", where) from None
 
@@ -178,15 +185,34 @@ def _misalignment(value: np.ndarray, here: str) -> np.ndarray:
     return value
 
 
-def _axis_to_package(imu: dict, where: str) -> tuple[np.ndarray, str | None]:
-    part = imu.get("part")
-    preset = get_part(part, f"{where}: imu.part") if part is not None else None
+def _preset(imu: dict, where: str, parts: dict[str, Part] | None) -> tuple[Part | None, str | None]:
+    """The preset ``[imu] part`` names (None for no part, or a label: a name that is not a preset, accepted
+    when the file gives every value itself) and the name the mount records."""
+    name = imu.get("part")
+    if name is None:
+        return None, None
+    if not isinstance(name, str) or not name.strip():
+        raise InputError(f"must be a part name (a string), not {literal(repr(name))}", f"{where}: imu.part")
+    preset = find_part(name, parts)
+    if preset is None and "axis_to_package" not in imu:
+        try:
+            get_part(name, f"{where}: imu.part", parts)
+        except InputError as exc:  # naming the known parts and the parts file; or the label
+            raise InputError(f"{exc.message}, or give axis_to_package in [imu] to use '{literal(name)}' as a label",
+                             exc.where) from None
+    return preset, (preset.name if preset else name.strip())
+
+
+def _axis_to_package(imu: dict, where: str, parts: dict[str, Part] | None = None) -> tuple[np.ndarray, str | None, dict]:
+    preset, part = _preset(imu, where, parts)
     raw = imu.get("axis_to_package")
     here = f"{where}: imu.axis_to_package"
+    used = {}
     if raw is None:
         if preset is None or preset.axis_to_package is None:
-            raise InputError("missing field (e.g. axis_to_package = \"1 deg\", or a known part)", here)
+            raise InputError("missing field (e.g. axis_to_package = \"1 deg\", or a part whose preset states it)", here)
         value = np.full(3, preset.si("axis_to_package", "angle"))
+        used = preset.provenance(["axis_to_package"])
     elif isinstance(raw, dict):
         check_keys(raw, "xyz", here)
         missing = [a for a in "xyz" if a not in raw]
@@ -195,7 +221,7 @@ def _axis_to_package(imu: dict, where: str) -> tuple[np.ndarray, str | None]:
         value = np.array([parse_quantity(raw[a], "angle", f"{here}.{a}") for a in "xyz"])
     else:
         value = np.full(3, parse_quantity(raw, "angle", here))
-    return _misalignment(value, here), (preset.name if preset else None)
+    return _misalignment(value, here), part, used
 
 
 def _extras(extras_t: dict, where: str) -> dict:
@@ -249,12 +275,16 @@ MOUNT_KEYS = {
 }
 
 
-def mount_from_dict(data: dict, where: str = "mount", base_dir: Path | None = None) -> Mount:
+def mount_from_dict(data: dict, where: str = "mount", base_dir: Path | None = None,
+                    parts: dict[str, Part] | None = None) -> Mount:
     """Build a :class:`Mount` from parsed TOML; every problem names the field.
 
     Unknown tables and keys are refused (:data:`MOUNT_KEYS`); dimensions must be
     positive, tolerances zero or more, misalignment bounds under 90 deg, the hole
-    larger than the screw and the screw pattern inside the package.
+    larger than the screw and the screw pattern inside the package. ``[imu] part`` is looked up in
+    ``parts`` (default the built-in presets, :data:`align.parts.PARTS`; a user's table from
+    :func:`align.parts.merge_parts`); a name that is not a preset is kept as a label when the file gives
+    ``axis_to_package`` itself. The preset values used are recorded in :attr:`Mount.preset`.
     """
     check_keys(data, MOUNT_KEYS, where)
     sections = {name: table(data, name, where, required=name in ("imu", "package", "screws")) for name in MOUNT_KEYS}
@@ -262,7 +292,7 @@ def mount_from_dict(data: dict, where: str = "mount", base_dir: Path | None = No
         if known is not None:
             check_keys(sections[name], known, f"{where}: [{name}]")
     imu, package, screws = sections["imu"], sections["package"], sections["screws"]
-    axis_to_package, part = _axis_to_package(imu, where)
+    axis_to_package, part, used = _axis_to_package(imu, where, parts)
     size_x = _length(package, "size_x", "package", where)
     size_y = _length(package, "size_y", "package", where)
     size_z = _length(package, "size_z", "package", where, default="10 mm")
@@ -288,4 +318,4 @@ def mount_from_dict(data: dict, where: str = "mount", base_dir: Path | None = No
     dists = {"imu": _distribution(imu, "imu", where), "ledges": _distribution(ledges, "ledges", where),
              "extras": _distribution(sections["extra"], "extra", where)}
     return Mount(axis_to_package, np.array([size_x, size_y, size_z]), pads, heights, size, tol, screw_d, hole_d,
-                 spacing_x, spacing_y, pos_tol, extras, dists, part, baseplate)
+                 spacing_x, spacing_y, pos_tol, extras, dists, part, baseplate, used)

@@ -128,16 +128,28 @@ def assembly_png(m: Mount, exaggerate: float = 30.0, skew: float | None = None) 
     for pad, h in zip(m.pads, heights):
         ring = np.vstack([pad, pad[:1]]) * 1e3
         ax.plot(ring[:, 0], ring[:, 1], np.full(len(ring), h * exaggerate * 1e3), color="k", lw=2)
+    # the package's axes, turned with it, from the centre of its top face; each labelled at its tip
+    origin = pose[:3, :3] @ np.array([0.0, 0.0, m.package[2]]) * 1e3 + pose[:3, 3] * 1e3
+    length = 0.3 * m.package.max() * 1e3
     for i, colour in enumerate(("tab:red", "tab:green", "tab:blue")):
-        tip = np.eye(3)[i] * 0.3 * m.package.max() * 1e3
-        ax.quiver(0, 0, m.package[2] * 1e3, *tip, color=colour, arrow_length_ratio=0.1)
+        tip = pose[:3, :3] @ np.eye(3)[i] * length
+        ax.quiver(*origin, *tip, color=colour, arrow_length_ratio=0.12, lw=1.6)
+        ax.text(*(origin + 1.18 * tip), f"{'xyz'[i]}", color=colour, fontsize=10, fontweight="bold",
+                ha="center", va="center")
+    from matplotlib.ticker import MaxNLocator
+
+    ax.zaxis.set_major_locator(MaxNLocator(3))  # the z range is short: a few ticks that do not overlap
+    ax.tick_params(axis="z", labelsize=8, pad=2)
     ax.set_xlabel("x [mm]")
     ax.set_ylabel("y [mm]")
-    ax.set_zlabel("z [mm]")
+    ax.set_zlabel("z [mm]", labelpad=4)
     tx, ty = np.degrees(np.arctan(b)), np.degrees(-np.arctan(a))
     ax.set_title(f"resting on ledges, +y ledges {m.height_tolerance * 1e3:g} mm high: tilt x {tx:.3f} deg, y {ty:.3f} deg\n"
-                 f"(grey nominal, red actual; angles exaggerated x{exaggerate:g})", fontsize=9)
-    ax.set_box_aspect((m.package[0], m.package[1], max(m.package[2], 0.3 * m.package[0])))
+                 f"(grey nominal, red actual; angles exaggerated x{exaggerate:g}; arrows: the package's x, y, z axes)",
+                 fontsize=9)
+    top = max(m.package[2] + length / 1e3, 0.45 * m.package[0])
+    ax.set_zlim(0, top * 1e3)
+    ax.set_box_aspect((m.package[0], m.package[1], top))
     return _figure_bytes(fig)
 
 

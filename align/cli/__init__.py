@@ -36,6 +36,7 @@ calibrate  calibrate ferraris | accel | mag | gyro
 from __future__ import annotations
 
 import difflib
+import functools
 import os
 import sys
 from typing import Annotated
@@ -109,9 +110,16 @@ def _unknown(kind: str, name: str, known: list[str]) -> str:
     return f"unknown {kind} {name}" + (f" (did you mean {' or '.join(close)}?)" if close else "")
 
 
+@functools.lru_cache(maxsize=1)
+def _click_app():
+    """The click command typer builds from ``app``, built once per process (typer rebuilds it on every
+    call: half of a short command's time, and a batch runs one command per unit)."""
+    return typer.main.get_command(app)
+
+
 def _params(path: list[str]) -> list:
     """The parameters of the command at ``path``, as typer builds them (``typer.main.get_command``)."""
-    command = typer.main.get_command(app)
+    command = _click_app()
     for word in path:
         command = getattr(command, "commands", {}).get(word)
     return list(getattr(command, "params", []))
@@ -194,6 +202,16 @@ def _known(path: list[str]) -> frozenset[str] | None:
     return frozenset(known)
 
 
+#: what Ctrl-C leaves behind, per command (default: nothing)
+_INTERRUPTED = {"batch": "interrupted; the units done are kept (results.parquet, units/): run the same command "
+                         "again to finish the rest"}
+
+
+def _interrupted(args: list[str]) -> str:
+    path, _ = _command_path(args)
+    return f"{PROG}: " + _INTERRUPTED.get(" ".join(path), "interrupted; nothing was written")
+
+
 def _internal(exc: BaseException) -> str:
     """One line for an unexpected exception: its type and its first 300 characters."""
     text = " ".join(f"{type(exc).__name__}: {exc}".split())
@@ -225,7 +243,7 @@ def run(args: list[str]) -> int:
                 warnings.simplefilter("ignore")
             return _run(args, debug)
     except KeyboardInterrupt:
-        _say(f"{PROG}: interrupted; nothing was written")
+        _say(_interrupted(args))
         return 130
     except BrokenPipeError:
         return _quiet_pipe()
@@ -247,7 +265,7 @@ def _run(args: list[str], debug: bool) -> int:
     command = " ".join(path) or None
     args = rewrite_aliases(command, args)
     try:
-        code = app(args=args, prog_name=PROG, standalone_mode=False)
+        code = _click_app()(args=args, prog_name=PROG, standalone_mode=False)
     except AlignError as exc:
         _say(f"{PROG}: error: {' '.join(exc.render(speller(command, _known(path))).split())}")  # one line, always
         return exc.exit_code
@@ -260,7 +278,7 @@ def _run(args: list[str], debug: bool) -> int:
                 return exc.exit_code
             return _fail(path, " ".join(_usage_message(exc, path, args).split()))
         if isinstance(exc, typer.Abort):  # click's answer to Ctrl-C
-            _say(f"{PROG}: interrupted; nothing was written")
+            _say(_interrupted(args))
             return 130
         if debug:
             raise
@@ -270,7 +288,7 @@ def _run(args: list[str], debug: bool) -> int:
         _say(f"{PROG}: internal error: {_internal(exc)} (set IMU_ALIGN_DEBUG=1 for details)")
         return 1
     if code == 130:  # typer's answer to Ctrl-C (KeyboardInterrupt inside a command), said in no words
-        _say(f"{PROG}: interrupted; nothing was written")
+        _say(_interrupted(args))
     return code if isinstance(code, int) else 0
 
 

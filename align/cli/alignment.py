@@ -110,13 +110,14 @@ def apply(
     units: opt.Units("Unit of the columns for an accelerometer or magnetometer result (default: the result's).") = None,
     columns: opt.Columns("Column names: time,x,y,z (x,y,z with --rate-hz); default per sensor.", optional=True) = None,
     rate_hz: opt.RateHz() = None,
+    plot: opt.OptInput("--plot", "Picture of the log before and after the correction (PNG).", "TRACES.png") = None,
     skip_rows: opt.SkipRows = 0,
     comment: opt.Comment = None,
     delimiter: opt.Delimiter = None,
     time_units: opt.TimeUnits = None,
 ) -> None:
     """Correct a log: gyro w = A (g - b); accelerometer M^-1 (a - b); magnetometer soft_iron (m - hard_iron)."""
-    check_outputs([log, alignment], out=out)
+    check_outputs([log, alignment], out=out, plot=plot)
     import numpy as np
 
     import align.io as fileio
@@ -157,8 +158,12 @@ def apply(
     check_corrected(kind, corrected, got.shown, field, str(log))  # a log read in the wrong unit is refused
     names = ([time_col] if time_col else []) + cols
     t = got.t / TIME_UNITS[got.time_units] if got.time_units else got.t  # the time column as the log had it
-    with outputs() as staged:
+    with outputs() as staged:  # all or none: the picture is drawn before anything is written
         staged.write_csv(out, names, np.column_stack(([t] if time_col else []) + [corrected / factor]))
+        if plot is not None:
+            from align.present.calplots import apply_traces_png
+
+            staged.write_bytes(plot, apply_traces_png(got.t, got.data, corrected, got.shown))
     typer.echo(f"wrote {out}: {len(t)} rows of {kind} data corrected with {alignment} ({u})"
                + (f"; {got.time_note()}" if got.time_note() else ""))
 

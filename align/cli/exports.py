@@ -1,8 +1,63 @@
-"""``imu-align`` export (results in the formats other programs load).
+"""``imu-align export``: results in the formats other programs load (Kalibr, C, CSV, imucal).
 
 Public names
 ------------
-COMMANDS
+export, COMMANDS
 """
 
-COMMANDS: dict = {}
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from align.cli import options as opt
+from align.cli.options import value
+from align.cli.paths import check_outputs, outputs
+
+
+def _rostopic(text: str) -> str:
+    """A ROS topic name: letters, digits, ``_``, ``/`` and ``~``."""
+    if not re.fullmatch(r"[~/]?[A-Za-z][A-Za-z0-9_/]*", text):
+        raise typer.BadParameter(f"'{text}' is not a ROS topic name; e.g. /imu0")
+    return text
+
+
+def _c_name(text: str) -> str:
+    """A C identifier."""
+    if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", text):
+        raise typer.BadParameter(f"'{text}' is not a C identifier (letters, digits and _); e.g. IMU_CAL")
+    return text
+
+
+def export(
+    results: Annotated[list[Path], typer.Argument(metavar="RESULT.json...", show_default=False, help=(
+        "Result file(s) of imu-align (--json). kalibr takes an allan result per sensor and an alignment or "
+        "calibration together; the others take one result."))],
+    to: opt.Choice("--to", ("kalibr", "c", "csv", "imucal"), "kalibr: Kalibr's imu.yaml (noise from allan; "
+                   "scale-misalignment intrinsics from matrix/calibrate); c: C header (alignment, calibration, "
+                   "magnetometer); csv: the Allan curve, or M, A and the angles; imucal: imucal's JSON (a calibration "
+                   "with accelerometer and gyroscope)."),
+    out: opt.OptInput("--out", "Write the export here (default: print it).", "FILE") = None,
+    name: Annotated[str | None, typer.Option("--name", parser=_c_name, metavar="PREFIX", help=(
+        "C header: prefix of the arrays (default IMU_ALIGN, IMU_CAL or IMU_MAG)."))] = None,
+    rostopic: Annotated[str, typer.Option("--rostopic", parser=_rostopic, metavar="TOPIC", help=(
+        "kalibr: the IMU's ROS topic."))] = "/imu0",
+) -> None:
+    """A result in the format another program loads, stating its convention, frame, units and the tool version."""
+    check_outputs(results, out=out)
+    from align.present.exports import export_text
+    from align.results import load_result
+
+    text = export_text([(load_result(p), str(p)) for p in results], value(to), name, rostopic)
+    if out is None:
+        typer.echo(text, nl=False)
+        return
+    with outputs() as staged:
+        staged.write_text(out, text)
+    typer.echo(f"wrote {out}: {value(to)} export of {', '.join(p.name for p in results)}")
+
+
+COMMANDS: dict = {"export": export}

@@ -13,6 +13,7 @@ import typer
 
 from align.cli import options as opt
 from align.cli.options import ACCURACY, NONNEGATIVE, NONZERO, PAUSE, POSITIVE, names
+from align.cli.parts import PartsFile, parts_file, parts_table
 from align.cli.paths import check_outputs, outputs
 from align.cli.progress import progress
 
@@ -133,38 +134,55 @@ def plan(
     rate_random_walk: opt.Text("--rate-random-walk", "rate_random_walk", "Rate random walk, e.g. '3 deg/h/sqrt(h)' "
                                "(with --arw).", "RRW", NONNEGATIVE, "'3 deg/h/sqrt(h)'") = None,
     imu: Annotated[str | None, typer.Option("--imu", metavar="PART", help=(
-        "A datasheet preset (see 'budget'), e.g. ADIS16485."))] = None,
+        "A datasheet preset (see 'imu-align parts'), e.g. ADIS16485; a name that is not a preset labels the "
+        "figures given with --arw."))] = None,
     allan_json: opt.OptInput("--allan", "A result of 'imu-align allan --json'.", "ALLAN.json") = None,
     turn_angle: opt.Quantity("--turn-angle", "angle", "Turn of the angle method.", "ANGLE", NONZERO,
                              "'360 deg'") = "360 deg",
     settle: opt.Quantity("--settle", "time", "Settling time added to each step.", "TIME", PAUSE, "'2 s'") = "2 s",
     steps: opt.Whole("--steps", "Table steps (6: +/- about three axes).", 1, 10_000, "6") = 6,
     json_out: opt.JsonOut = None,
+    parts: PartsFile = None,
 ) -> None:
     """Averaging time per table step for an alignment goal (Example 3), and the whole plan."""
     from align.errors import InputError
+    from align.parts import find_part, get_part
 
-    if sum(x is not None for x in (arw, imu, allan_json)) != 1:
-        raise InputError("give exactly one noise source: {arw} X [{bias_instability} Y], {imu} PART or {allan_json} "
-                         "RESULT.json", "plan")
+    check_outputs([allan_json, parts_file(parts)[0]], json_out=json_out)
+    table = parts_table(parts) if imu is not None or parts is not None else None
+    preset = None if imu is None else find_part(imu, table)
+    if imu is not None and preset is None and arw is None:
+        try:
+            get_part(imu, "{imu}", table)
+        except InputError as exc:  # naming the known parts and the parts file; or the label
+            raise InputError(f"{exc.message}, or give {{arw}} (and {{bias_instability}}) to use it as a label",
+                             exc.where) from None
+    if sum(x is not None for x in (arw, preset, allan_json)) != 1:
+        raise InputError("give exactly one noise source: {arw} X [{bias_instability} Y] (with {imu} NAME, a name that "
+                         "is not a preset, as its label), {imu} PART (a preset) or {allan_json} RESULT.json", "plan")
     if arw is None and (bias_instability or rate_random_walk):
         raise InputError("goes with {arw}", "{bias_instability}" if bias_instability else "{rate_random_walk}")
-    check_outputs([allan_json], json_out=json_out)
     from align.noise import AllanJob, make_plan, plan_from_allan, preset_model
-    from align.parts import get_part
     from align.present.text import plan_summary
     from align.results import load_result
 
     common = dict(turn_angle=turn_angle, steps=steps, settle=settle)
+    inputs: dict = {}
     if allan_json is not None:
         job = load_result(allan_json, expect=(AllanJob,))
         result = plan_from_allan(job, rate, accuracy, noise_ratio, where=str(allan_json), **common)
     else:
         if arw is not None:
             label, curve = _model_curve(arw, bias_instability, rate_random_walk)
+            if imu is not None:
+                label, inputs = f"{imu.strip()} (a label, not a preset): {label}", {"imu": imu.strip()}
         else:
-            label, curve = preset_model(get_part(imu, "{imu}"))
-        result = make_plan(rate, accuracy, noise_ratio, label, sigma=curve, **common)
+            label, curve = preset_model(preset)  # its N: arw, else noise_density; its B when stated
+            used = ["arw" if preset.arw is not None else "noise_density", "bias_instability"]
+            inputs = {"imu": preset.name, "preset": preset.provenance(used)}
+        if parts_file(parts)[0] is not None and imu is not None:
+            inputs["parts"] = str(parts_file(parts)[0])
+        result = make_plan(rate, accuracy, noise_ratio, label, sigma=curve, **common).replace(inputs=inputs)
     with outputs() as out:
         if json_out is not None:
             out.write_json(json_out, result)

@@ -6,12 +6,14 @@ report, demo, COMMANDS
 """
 
 from pathlib import Path
+from typing import Annotated
 
 import typer
 
 from align.cli import options as opt
 from align.cli.mechanics import MANOEUVRE_HELP, MOUNT_HELP
 from align.cli.options import ACCURACY, POSITIVE
+from align.cli.parts import PartsFile, parts_file, parts_table
 from align.cli.paths import check_outputs, data_files, outputs
 from align.cli.progress import progress
 
@@ -20,13 +22,45 @@ DEMO_FILES = ("mount.toml", "manoeuvre.toml", "static.npy", "session.csv", "plan
               "allowable.json", "check.json", "allan.json", "plan.json", "alignment.json", "truth.json", "report.html")
 
 
+def _when() -> str:
+    """The report's date: now, local time to the minute; ``SOURCE_DATE_EPOCH`` (seconds, UTC) when set, for
+    reproducible reports."""
+    import os
+    from datetime import UTC, datetime
+
+    epoch = os.environ.get("SOURCE_DATE_EPOCH", "").strip()
+    if epoch.isdigit():
+        return datetime.fromtimestamp(int(epoch), UTC).strftime("%Y-%m-%d %H:%M UTC")
+    return datetime.now().astimezone().strftime("%Y-%m-%d %H:%M %Z").strip()
+
+
+Repeated = Annotated[list[Path] | None, typer.Option("--calibration", metavar="RESULT.json", help=(
+    "A calibration result (calibrate accel, ferraris, gyro or mag --json); repeat for several."))]
+Drift = Annotated[list[Path] | None, typer.Option("--drift", metavar="RESULT.json", help=(
+    "A navigation result whose error growth the report shows (issue 16); repeat for several."))]
+
+
+def _label(flag: str, help: str, metavar: str = "TEXT"):
+    return Annotated[str | None, typer.Option(flag, metavar=metavar, help=help)]
+
+
 def report(
-    mount: opt.Input("--mount", MOUNT_HELP, "MOUNT.toml"),
-    manoeuvre: opt.Input("--manoeuvre", MANOEUVRE_HELP, "MANOEUVRE.toml"),
     out: opt.Input("--out", "The HTML report to write.", "REPORT.html"),
+    mount: opt.OptInput("--mount", MOUNT_HELP, "MOUNT.toml") = None,
+    manoeuvre: opt.OptInput("--manoeuvre", MANOEUVRE_HELP + " With --mount: the budget is checked against it; with "
+                            "an alignment: the measured misalignment is.", "MANOEUVRE.toml") = None,
     log: opt.OptInput("--log", "Rate-table log (time,gyro_x,gyro_y,gyro_z) for the alignment, with --plan.", "LOG") = None,
     plan: opt.OptInput("--plan", "Its test plan TOML ([[step]] tables).", "PLAN.toml") = None,
-    allan_log: opt.OptInput("--allan", "Static recording for the Allan deviation and the test plan.", "STATIC") = None,
+    alignment: opt.OptInput("--alignment", "An alignment result (matrix --json) instead of --log and --plan.",
+                            "RESULT.json") = None,
+    allan_log: opt.OptInput("--allan", "Static recording, or an Allan result (allan --json), for the noise figures and "
+                            "the test plan.", "STATIC") = None,
+    calibration: Repeated = None,
+    drift: Drift = None,
+    title: Annotated[str, typer.Option("--title", metavar="TEXT", help="Title of the report.")] = "IMU alignment report",
+    serial: _label("--serial", "Serial number of the unit tested.") = None,
+    operator: _label("--operator", "Who ran the test.") = None,
+    test_id: _label("--test-id", "Identifier of the test (a work order, a run number).") = None,
     columns: opt.Columns("Columns of the static recording (--allan).") = "gyro_x,gyro_y,gyro_z",
     rate_hz: opt.RateHz("Sample rate of the static recording, when it has no time column.") = None,
     units: opt.UnitFlag("--units", "Unit of the static recording (an angular rate).") = "deg/s",
@@ -41,23 +75,35 @@ def report(
     comment: opt.Comment = None,
     delimiter: opt.Delimiter = None,
     time_units: opt.TimeUnits = None,
+    parts: PartsFile = None,
 ) -> None:
-    """One self-contained HTML report: budget, allowance, noise plan and alignment."""
-    from align.errors import InputError
+    """One self-contained HTML report from any subset of results: budget, allowance, alignment, noise, calibrations.
+
+    A summary comes first: every check, its verdict and the number behind it. The exit status is 4 when a
+    check fails (the budget or the measured misalignment over the allowance); the report is written first.
+    """
+    from align.errors import CheckFailed, InputError
 
     if (log is None) != (plan is None):
         raise InputError("give {log} and {plan} together", "{log}" if log is None else "{plan}")
-    check_outputs([mount, manoeuvre, log, plan, allan_log, *data_files(mount, manoeuvre)], out=out)
-    from align.present.story import build_report
+    calibrations, drifts = list(calibration or []), list(drift or [])
+    check_outputs([mount, manoeuvre, log, plan, alignment, allan_log, *calibrations, *drifts, parts_file(parts)[0],
+                   *data_files(mount, manoeuvre)], out=out)
+    from align.present.story import make_report
 
-    with progress(monte_carlo, "Monte Carlo") as tick:
-        page, summary, _ = build_report(
+    header = {"serial number": serial, "operator": operator, "test": test_id, "date": _when()}
+    with progress(monte_carlo if mount is not None else 0, "Monte Carlo") as tick:
+        done = make_report(
             mount, manoeuvre, log=log, plan=plan, allan=allan_log, allan_columns=columns, allan_rate_hz=rate_hz,
             allan_units=units, gyro_units=gyro_units, table_rate=rate, accuracy=accuracy, monte_carlo=monte_carlo,
-            seed=seed, progress=tick, log_format=opt.log_format(skip_rows, comment, delimiter, time_units))
+            seed=seed, progress=tick, log_format=opt.log_format(skip_rows, comment, delimiter, time_units),
+            alignment=alignment, calibrations=calibrations, drift=drifts, title=title, header=header,
+            parts=parts_table(parts))
     with outputs() as staged:
-        staged.write_text(out, page)
-    typer.echo(summary + f"\nreport: {out}")
+        staged.write_text(out, done.page)
+    typer.echo(done.text + f"\nreport: {out}")
+    if done.failed:  # as 'check': the report is written, then the failure is the exit status
+        raise CheckFailed("; ".join(f"{v.check} failed ({v.number})" for v in done.failed))
 
 
 def demo(

@@ -1,7 +1,8 @@
 """The whole story in one call: budget, allowance, noise plan and alignment, and the report.
 
-:func:`build_report` runs every job whose inputs are given and returns the HTML
-page, a short text summary and the JSON-ready results; :func:`demo_inputs`
+:func:`make_report` runs every job whose inputs are given (any subset: the jobs are in
+:mod:`align.present.jobs`) and returns the HTML page, a short text summary, the JSON-ready results and
+the verdicts of the summary at the top of the page (:func:`build_report`: the first three); :func:`demo_inputs`
 stages the bundled inputs (the reference's Examples 1 and 2, a simulated static
 record and a simulated rate-table session) in the run's
 :class:`~align.io.outputs.Outputs`, so that the demo is a report of real files
@@ -9,19 +10,20 @@ like any other, and a demo that fails leaves none of them behind.
 
 Public names
 ------------
-build_report, demo_inputs, run_demo, DEMO_TITLE, DEMO
+make_report, Outcome, build_report, demo_inputs, run_demo, DEMO_TITLE, DEMO, PARTS
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from align.io import LogFormat, read_sensor_log, read_static, read_toml
+from align.io import LogFormat
 from align.io.outputs import Outputs
-from align.units import DEG, DEG_H, parse_unit
+from align.units import DEG
 from align.units import parse_quantity as q
 
 DEMO = Path(__file__).with_name("demo")
@@ -77,96 +79,128 @@ def _npy(arr: np.ndarray) -> bytes:
     return buf.getvalue()
 
 
-def build_report(mount: Path, manoeuvre: Path, log: Path | None = None, plan: Path | None = None,
-                 allan: Path | None = None, allan_columns: str = "gyro_x,gyro_y,gyro_z", allan_rate_hz: float | None = None,
-                 allan_units: str = "deg/s", gyro_units: str = "deg/s", table_rate: str = "100 deg/s",
-                 accuracy: str = "0.1 deg", noise_ratio: float = 10.0, monte_carlo: int = 100_000, seed: int = 0,
-                 basis: str = "rss", progress=None, title: str = "IMU alignment report",
-                 source: Callable[[Path], Path] | None = None,
-                 log_format: LogFormat | None = None) -> tuple[str, str, dict]:
-    """Run every job whose inputs are given; return (HTML, summary text, results).
+#: the order of the report's parts after the summary (the inputs come last)
+PARTS = ("measured", "mount", "alignment", "noise", "calibration", "navigation")
 
-    The inputs are named by their paths; ``source`` maps such a path to the file to read, when
-    that differs (the demo reads its staged inputs: :meth:`align.io.outputs.Outputs.staged`).
-    ``log_format`` (a logger file's preamble, comments, delimiter, time unit) applies to the
-    rate-table log and the static record alike.
+
+@dataclass(frozen=True)
+class Outcome:
+    """A report and what it found.
+
+    Attributes
+    ----------
+    page : str
+        The HTML report.
+    text : str
+        The terminal summary: one line per job, then the verdict.
+    results : dict of str -> Result
+        Every job's result (the demo saves each as ``<name>.json``).
+    verdicts : tuple of Verdict
+        The summary's checks, in the order shown.
+    measured : tuple of MeasuredMargin
+        The measured misalignment against the allowance, element by element (empty without both).
+    """
+
+    page: str
+    text: str
+    results: dict
+    verdicts: tuple
+    measured: tuple = ()
+
+    @property
+    def failed(self) -> list:
+        """The checks that failed (the command exits 4 when there is one)."""
+        return [v for v in self.verdicts if v.failed]
+
+
+def make_report(mount: Path | None = None, manoeuvre: Path | None = None, log: Path | None = None,
+                plan: Path | None = None, allan: Path | None = None, allan_columns: str = "gyro_x,gyro_y,gyro_z",
+                allan_rate_hz: float | None = None, allan_units: str = "deg/s", gyro_units: str = "deg/s",
+                table_rate: str = "100 deg/s", accuracy: str = "0.1 deg", noise_ratio: float = 10.0,
+                monte_carlo: int = 100_000, seed: int = 0, basis: str = "rss", progress=None,
+                title: str = "IMU alignment report", source: Callable[[Path], Path] | None = None,
+                log_format: LogFormat | None = None, alignment: Path | None = None, calibrations: Sequence[Path] = (),
+                drift: Sequence[Path] = (), header: dict | None = None, parts: dict | None = None) -> Outcome:
+    """Run every job whose inputs are given, from any subset of them, and build the report.
+
+    Parameters
+    ----------
+    mount, manoeuvre : Path, optional
+        Mount and manoeuvre TOML: the budget (Eq 1-4, Monte Carlo) and what the manoeuvre allows.
+    log, plan : Path, optional
+        A rate-table log and its plan, aligned here (both or neither); or ``alignment``, an alignment result file.
+    allan : Path, optional
+        A static record (``allan_columns``, ``allan_rate_hz``, ``allan_units``) or an Allan result file (``.json``);
+        a gyro's gives the test plan for ``table_rate``, ``accuracy``, ``noise_ratio``.
+    calibrations : sequence of Path
+        Calibration result files (accelerometer, Ferraris, gyro, magnetometer).
+    drift : sequence of Path
+        Navigation results whose error growth is shown (:mod:`align.present.navigation`).
+    parts : dict of str to Part, optional
+        The presets the mount's part is looked up in (:func:`align.parts.merge_parts`); the built-in table when None.
+    header : dict, optional
+        The report's identification (``"serial number"``, ``"operator"``, ``"test"``, ``"date"``), shown under
+        the title with the tool's version.
+    source : callable, optional
+        Maps an input's path (as shown) to the file to read (the demo reads its staged inputs).
+    log_format : LogFormat, optional
+        A logger file's preamble, comments, delimiter, time unit: for the rate-table log and the static record.
+
+    Returns
+    -------
+    Outcome
+        The summary (every check, its verdict and its number) comes first on the page, the inputs last.
+
+    Raises
+    ------
+    InputError
+        No input at all, ``log`` without ``plan`` (or the reverse), ``log`` with ``alignment``, or a bad file.
     """
     import align.present.html as report
-    from align.sensitivity import allowable, check_margins, manoeuvre_from_dict
-    from mechanics.budget import budget
-    from mechanics.montecarlo import monte_carlo as run_mc
-    from mechanics.mount import mount_from_dict
-    from mechanics.render import assembly_png, histogram_png
+    from align.errors import InputError
+    from align.present import jobs
+    from align.present.verdicts import INFO, Verdict, summary_section
 
-    src = source or Path
-    m = mount_from_dict(read_toml(src(mount)), str(mount), Path(mount).parent)
-    b = budget(m)
-    if monte_carlo:
-        b = b.replace(monte_carlo=run_mc(m, monte_carlo, seed, progress=progress))
-    man = manoeuvre_from_dict(read_toml(src(manoeuvre)), str(manoeuvre), Path(manoeuvre).parent)
-    inputs = {"mount": (str(mount), _text(src(mount))), "manoeuvre": (str(manoeuvre), _text(src(manoeuvre)))}
-    allow = allowable(man)
-    table = check_margins(b.elements(basis), allow, basis)
-    sections = [report.budget_section(b, histogram_png(b) if monte_carlo else None, assembly_png(m)),
-                report.allowance_section(allow, table, basis)]
-    results = {"budget": b, "allowable": allow, "check": table}
-    lines = [f"budget: source total {b.total / DEG:.4f} deg, worst case {b.worst_case / DEG:.4f} deg"
-             + (f", Monte Carlo p99.73 any axis {b.monte_carlo.percentiles['99.73'][3] / DEG:.4f} deg" if monte_carlo else ""),
-             f"allowance: binding {allow.binding} = {allow.binding_value / DEG:.4f} deg; budget ({basis}) "
-             f"{'PASSES' if table.passed else 'FAILS'} the check"]
-    job = pl = plot = None
+    if (log is None) != (plan is None):
+        raise InputError("give {log} and {plan} together", "{log}" if log is None else "{plan}")
+    if log is not None and alignment is not None:
+        raise InputError("give a rate-table log and its plan, or an alignment result, not both", "{alignment}")
+    if all(x is None for x in (mount, manoeuvre, log, allan, alignment)) and not calibrations and not drift:
+        raise InputError("nothing to report: give at least one of {mount}, {manoeuvre}, {log} with {plan}, {alignment}, "
+                         "{allan}, {calibration}, {drift}")
+    rep = jobs.Report(source or Path)
+    b = m = None
+    if mount is not None:
+        b, m = jobs.mount_job(rep, mount, monte_carlo, seed, progress, parts)
+    allow = jobs.manoeuvre_job(rep, manoeuvre, b, m, basis, monte_carlo)
+    if log is not None or alignment is not None:
+        jobs.alignment_job(rep, allow, log, plan, alignment, gyro_units, log_format)
+    elif allow is not None and b is None:
+        rep.verdicts.append(Verdict("allowance", INFO, f"binding {allow.binding} = {allow.binding_value / DEG:.4f} deg",
+                                    allow.binding_value / DEG, "no budget or alignment given to check against it"))
     if allan is not None:
-        from align.noise import plan_from_allan, run_allan
-        from align.present.plots import allan_plot_png
-
-        names = [c.strip() for c in allan_columns.split(",")]
-        parse_unit(allan_units, "angular_rate", "{allan_units}")  # the plan needs a gyro's record
-        data, fs = read_static(src(allan), names, allan_rate_hz, log_format)
-        job = run_allan([data], fs, names, allan_units, where=str(allan))
-        pl = plan_from_allan(job, q(table_rate, "angular_rate", "{rate}"), q(accuracy, "angle", "{accuracy}"), noise_ratio,
-                             "measured curve (worst channel)")
-        job = job.replace(inputs=(str(allan),), plan=pl)
-        plot = allan_plot_png(job, pl.noise_target, pl.averaging.tau)
-        inputs["static record"] = (str(allan), "")
-        results["allan"], results["plan"] = job, pl
-        avg = "infeasible" if pl.averaging.tau is None else f"{pl.averaging.tau:.4g} s per step"
-        lines.append(f"plan: noise target {pl.noise_target / DEG_H:.2f} deg/h at {table_rate}, {accuracy}: averaging {avg}")
-    sections.append(report.allan_section(job, plot, pl) if allan is not None else
-                    report.Section("Noise and test planning", "<p>No static record given.</p>"))
-    if log is not None and plan is not None:
-        from align.alignment.job import align
-        from align.alignment.plan import Plan
-        from align.present.plots import segmentation_plot_png
-
-        the_plan = Plan.from_dict(read_toml(src(plan)), str(plan))
-        got = read_sensor_log(src(log), ["gyro_x", "gyro_y", "gyro_z"], gyro_units, log_format=log_format)
-        t, g = got.t, got.data
-        r = align(t, g, the_plan, units=got.shown, where=str(log))
-        r = r.replace(notes=r.notes + tuple(filter(None, [got.time_note()])))
-        sections.append(report.alignment_section(r, segmentation_plot_png(t, g, r, r.units)))
-        inputs["rate-table log"] = (str(log), "")
-        inputs["plan"] = (str(plan), _text(src(plan)))
-        results["alignment"] = r
-        ang = r.angles
-        lines.append(f"alignment: psi = {', '.join(f'{v / DEG:.3f}' for v in ang.psi)} deg, "
-                     f"sigma(M) <= {np.nanmax(r.sigma_M):.1e}, "
-                     f"checks: {_check_counts(r.checks)}"
-                     + (f"; {len(r.motions)} motion(s) no step claimed, ignored" if r.motions else ""))
-    sections.insert(0, report.inputs_section(inputs))
-    return report.html_report(title, sections), "\n".join(lines), results
+        jobs.allan_job(rep, allan, allan_columns, allan_rate_hz, allan_units, table_rate, accuracy, noise_ratio, log_format)
+    for path in calibrations:
+        jobs.calibration_job(rep, path)
+    for path in drift:  # issue 16: the error growth of a navigation result
+        jobs.drift_job(rep, path)
+    sections = [summary_section(rep.verdicts)]
+    sections += [s for part in PARTS for s in rep.sections.get(part, [])]
+    sections.append(report.inputs_section(rep.inputs))
+    failed = [v for v in rep.verdicts if v.failed]
+    if failed:
+        verdict = "FAIL (" + "; ".join(f"{v.check}: {v.number}" for v in failed) + ")"
+    else:
+        verdict = "PASS" if any(v.status == "PASS" for v in rep.verdicts) else "no requirement checked"
+    text = "\n".join(rep.lines + [f"summary: {verdict}"])
+    return Outcome(report.html_report(title, sections, header), text, rep.results, tuple(rep.verdicts),
+                   tuple(rep.measured))
 
 
-def _text(path: Path) -> str:
-    """The text of an input already read by its checked reader, for the report (undecodable bytes shown as such)."""
-    return Path(path).read_bytes().decode("utf-8", "replace")
-
-
-def _check_counts(checks) -> str:
-    """``"5 pass, 1 not checked"``: how many checks ended in each status."""
-    counts: dict[str, int] = {}
-    for c in checks:
-        counts[c.status] = counts.get(c.status, 0) + 1
-    return ", ".join(f"{n} {status}" for status, n in counts.items())
+def build_report(mount: Path | None = None, manoeuvre: Path | None = None, **kwargs) -> tuple[str, str, dict]:
+    """:func:`make_report` as ``(HTML, summary text, results)``."""
+    out = make_report(mount, manoeuvre, **kwargs)
+    return out.page, out.text, out.results
 
 
 def run_demo(out: Path, staged: Outputs, progress=None) -> tuple[str, str, dict]:

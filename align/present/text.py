@@ -5,8 +5,8 @@ are the result's file units.
 
 Public names
 ------------
-matrix_text, alignment_summary, budget_summary, allowable_summary, margin_summary,
-allan_summary, plan_summary, calibration_summary, magnetometer_summary
+matrix_text, angle_lines, alignment_summary, budget_summary, allowable_summary, margin_summary,
+allan_summary, plan_summary, calibration_summary, magnetometer_summary, preset_lines (from :mod:`align.present.presets`)
 """
 
 from __future__ import annotations
@@ -18,6 +18,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from align.alignment.result import AlignmentResult
+from align.io.export import matrix_unit
+from align.model import Angles, angles
+from align.present.presets import preset_lines
 from align.units import DEG, to_unit
 
 if TYPE_CHECKING:
@@ -43,6 +46,25 @@ def _assumed_gyro(r: AlignmentResult) -> int | None:
     return None if r.inferred_axis is None else int(np.argmax(np.abs(r.mounting[:, r.inferred_axis])))
 
 
+def angle_lines(ang: Angles, assumed: int | None = None, indent: str = "  ") -> list[str]:
+    """Scale factors and the misalignment angles in degrees (reference section 1), as ``matrix`` prints them.
+
+    Parameters
+    ----------
+    ang : Angles
+        From :func:`align.model.angles` of ``M`` (rows are sensor axes).
+    assumed : int, optional
+        The axis whose scale was assumed, not measured (marked).
+    """
+    return [indent + "scale factors      " + "  ".join(f"{s:.6f}" + ("(assumed)" if i == assumed else "")
+                                                   for i, s in enumerate(ang.scale)),
+            indent + "psi (axis-frame)   " + "  ".join(f"{k}={v / DEG:.4f}" for k, v in zip("xyz", ang.psi)),
+            indent + "phi (cross-axis)   " + "  ".join(f"{'xyz'[i]}{'xyz'[j]}={ang.phi[i, j] / DEG:+.4f}"
+                                                     for i in range(3) for j in range(3) if i != j),
+            indent + "delta (axis-axis)  " + "  ".join(f"{p}={v / DEG:+.4f}" for p, v in zip(("xy", "xz", "yz"), ang.delta)),
+            indent + "mounting rotation  " + ", ".join(f"{v / DEG:+.4f}" for v in ang.mounting_rotvec) + " (rotation vector)"]
+
+
 def alignment_summary(r: AlignmentResult) -> str:
     """The summary ``imu-align matrix`` prints: M, A, bias, angles, segments, checks."""
     u = r.units
@@ -53,13 +75,7 @@ def alignment_summary(r: AlignmentResult) -> str:
            "bias [" + u + "]: " + ", ".join(f"{b:+.5g} ± {s:.2g}" for b, s in zip(to_unit(r.bias, u), to_unit(r.sigma_bias, u))),
            "",
            "angles [deg]" + ("" if np.allclose(r.mounting, np.eye(3)) else ", relative to the nominal mounting") + ":",
-           "  scale factors      " + "  ".join(f"{s:.6f}" + ("(assumed)" if i == _assumed_gyro(r) else "")
-                                               for i, s in enumerate(ang.scale)),
-           "  psi (axis-frame)   " + "  ".join(f"{k}={v / DEG:.4f}" for k, v in zip("xyz", ang.psi)),
-           "  phi (cross-axis)   " + "  ".join(f"{'xyz'[i]}{'xyz'[j]}={ang.phi[i, j] / DEG:+.4f}"
-                                                 for i in range(3) for j in range(3) if i != j),
-           "  delta (axis-axis)  " + "  ".join(f"{p}={v / DEG:+.4f}" for p, v in zip(("xy", "xz", "yz"), ang.delta)),
-           "  mounting rotation  " + ", ".join(f"{v / DEG:+.4f}" for v in ang.mounting_rotvec) + " (rotation vector)",
+           *angle_lines(ang, _assumed_gyro(r)),
            "",
            f"design condition number {r.condition_number:.3g}, {r.dof} degrees of freedom per gyro",
            "", "segments (residual / noise, per gyro):"]
@@ -82,11 +98,12 @@ def budget_summary(b) -> str:
     lines = [
         "Mounting-misalignment budget (angle between each gyro axis and its system axis)",
         "",
-        f"  part {m['part'] or '-'}, axis-to-package {', '.join(f'{v:.3g}' for v in m['axis_to_package_deg'])} deg, "
+        f"  part {m['part'] or 'not named'}, axis-to-package {', '.join(f'{v:.3g}' for v in m['axis_to_package_deg'])} deg, "
         f"package {m['package_mm'][0]:g} x {m['package_mm'][1]:g} mm, ledges {m['ledge_size_mm']:g} mm, "
         f"height band {m['height_tolerance_mm']:g} mm, "
         f"screws {m['screw_diameter_mm']:g} mm in {m['hole_diameter_mm']:g} mm holes, "
         f"R_S {m['screw_radius_mm']:.4f} mm",
+        *preset_lines(b, "    "),
         "",
         "  source (Eq 1-4)                        deg",
         f"    tilt about x   (Eq 2)           {d['tilt_x_deg']:10.5f}",
@@ -273,21 +290,27 @@ def plan_summary(plan: PlanResult) -> str:
     turn = d["angle_method"]["longest_turn_s"]
     lines.append(f"  angle method        turns of {d['angle_method']['turn_angle_deg']:g} deg must last at most "
                  + ("(none meets it)" if turn is None else f"{turn:.4g} s"))
-    return "\n".join(lines)
+    return "\n".join(lines + preset_lines(plan))
+
+
+def _unit_text(unit: str) -> str:
+    return "dimensionless" if unit == "1" else unit
 
 
 def calibration_summary(cals: dict) -> str:
-    """Text for ``imu-align calibrate ferraris/accel``."""
+    """Text for ``imu-align calibrate ferraris/accel/gyro``: per sensor ``M`` with its unit and 1-sigma, the bias,
+    the misalignment angles of ``M``'s rows in degrees (as ``matrix``), residuals and notes."""
     out = []
     for name, c in cals.items():
         d = c.to_dict()
         u = d["units"]["bias"]
         out += [f"{name} ({d['method']}), convention {d['convention']}",
-                "  M (1-sigma):", matrix_text(c.M, c.sigma_M, 6, "    "),
+                f"  M [{_unit_text(matrix_unit(c.units, c.sensor))}] (1-sigma):", matrix_text(c.M, c.sigma_M, 6, "    "),
                 f"  bias [{u}]: " + ", ".join(f"{b:+.6g} ± {s:.2g}" for b, s in zip(d["bias"], d["uncertainty"]["bias"]))]
         if "g_sensitivity" in d:
             out.append(f"  g-sensitivity [{d['units']['g_sensitivity']}]:")
             out.append(matrix_text(np.array(d["g_sensitivity"]), None, 6, "    "))
+        out += ["  angles of M's rows (sensor axes) in the calibration frame [deg]:", *angle_lines(angles(c.M), None, "    ")]
         if d["residuals"]:
             worst = max(d["residuals"].items(), key=lambda kv: float(np.max(np.abs(kv[1]))))
             out.append(f"  largest residual: {worst[0]} {np.max(np.abs(worst[1])):.3g} {u} ({len(d['residuals'])} positions)")
@@ -298,13 +321,32 @@ def calibration_summary(cals: dict) -> str:
 
 
 def magnetometer_summary(c) -> str:
-    """Text for ``imu-align calibrate mag``."""
+    """Text for ``imu-align calibrate mag``: hard iron, soft iron (dimensionless), the rotation to the accelerometer
+    when found, and the angles in degrees of ``M = (misalignment soft_iron)^-1`` (the model ``m_raw = M m + h``,
+    rows the magnetometer axes), as ``matrix`` prints them."""
     d = c.to_dict()
     u, q = d["units"]["hard_iron"], d["quality"]
+    whole = c.soft_iron if c.misalignment is None else c.misalignment @ c.soft_iron
+    frame = {"axis-down": " in the body (fixture) frame, from the axis-down turns",
+             "gravity": " in the accelerometer frame"}.get(c.misalignment_method, " in the body frame")
+    rot = d.get("misalignment_angles")
+    rot_lines = [] if rot is None else [
+        "  misalignment rotation (alpha, beta, gamma about x, y, z) [deg]: "
+        + ", ".join(f"{a:+.3f}" + ("" if s is None else f" ± {s:.3f}")
+                    for a, s in zip(rot["angles_deg"], rot["sigma_deg"] or [None] * 3))
+        + ("" if rot["sigma_deg"] is None else " (1 sigma)")]
     lines = [f"magnetometer ({d['model']} soft iron), convention {d['convention']}",
              f"  hard iron [{u}]: "
              + ", ".join(f"{h:+.5g} ± {s:.2g}" for h, s in zip(d["hard_iron"], d["uncertainty"]["hard_iron"])),
-             "  soft iron:", matrix_text(c.soft_iron, None, 5, "    "),
+             "  soft iron [dimensionless]" + ("" if c.sigma_soft_iron is None else " (± 1 sigma)") + ":",
+             matrix_text(c.soft_iron, c.sigma_soft_iron, 5, "    "),
+             *(["  misalignment (m_body = misalignment m_cal) [dimensionless]:", matrix_text(c.misalignment, None, 5, "    ")]
+               if c.misalignment is not None else []),
+             *rot_lines,
+             "  angles of M = (" + ("misalignment " if c.misalignment is not None else "")
+             + "soft_iron)^-1, rows the magnetometer axes"
+             + (frame if c.misalignment is not None else "") + " [deg]:",
+             *angle_lines(angles(np.linalg.inv(whole)), None, "    "),
              f"  field {d['field']:.5g} {u}; field-magnitude spread {100 * q['field_spread_before']:.2f} % before, "
              f"{100 * q['field_spread_after']:.2f} % after; direction coverage {q['coverage']:.3f} (full sphere 0.333)",
              f"  predicted heading error {q['predicted_heading_error_deg']:.2f} deg (1 sigma)"]

@@ -656,7 +656,8 @@ def _mount_and_manoeuvres(d: Path) -> None:
     w("mount_huge.toml", _toml_lines(mount, 'height_tolerance = "0.2 mm"', 'height_tolerance = "1e300 mm"'))
     w("mount_tilt_neg.toml", _toml_lines(mount, 'axis_to_package = "1 deg"', 'axis_to_package = "-1 deg"'))
     w("mount_tilt_big.toml", _toml_lines(mount, 'axis_to_package = "1 deg"', 'axis_to_package = "400 deg"'))
-    w("mount_part.toml", _toml_lines(mount, 'part = "ADIS16485"', 'part = "ADIS99999"'))
+    w("mount_part.toml", _toml_lines(_toml_lines(mount, 'part = "ADIS16485"', 'part = "ADIS99999"'),
+                                     'axis_to_package = "1 deg"\n', ""))
     w("mount_hole.toml", _toml_lines(mount, 'hole_diameter = "2.85 mm"', 'hole_diameter = "1.5 mm"'))
     w("mount_dist.toml", _toml_lines(mount, "[ledges]", '[ledges]\ndistribution = "gaussian"'))
     w("mount_noledges.toml", mount.split("[ledges]")[0] + "[screws]" + mount.split("[screws]")[1])

@@ -14,11 +14,17 @@ from mechanics.mount import Mount, corner_ledges
     ("ledges", "height_tolerance", "-0.2 mm", "ledges.height_tolerance"),
     ("package", "size_x", None, "package.size_x"),
     ("screws", "diameter", "2 deg", "screws.diameter"),
-    ("imu", "part", "XYZ123", "imu.part"),
 ])
 def test_bad_mount_input_names_the_field(section, field, value, words):
     with pytest.raises(InputError, match=words.replace(".", r"\.")):
         example1(**{f"{section}__{field}": value})
+
+
+def test_unknown_part_is_refused_without_its_values_and_a_label_with_them():
+    with pytest.raises(InputError, match=r"imu\.part: unknown part 'XYZ123'.*as a label"):
+        example1(imu__part="XYZ123", imu__axis_to_package=None)
+    m = example1(imu__part="XYZ123")
+    assert m.part == "XYZ123" and m.preset == {}
 
 
 def test_mount_is_a_frozen_value_and_round_trips():
