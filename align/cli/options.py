@@ -117,6 +117,7 @@ COMMAND_FLAGS: dict[str, dict[str, str]] = {
     "calibrate ferraris": {"units": "--accel-units", "columns": "--accel-columns or --gyro-columns"},
     "calibrate accel": {"units": "--accel-units"},
     "calibrate mag": {"units": "--mag-units"},
+    "drift": {"manoeuvre": "--manoeuvre"},
 }
 
 #: command -> old flag -> its name today; accepted, not shown in --help
