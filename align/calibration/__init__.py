@@ -9,6 +9,12 @@ results       Calibration (one sensor's ``[M | b]``) and CalibrationSet (the ``i
 accel         accelerometer: multi-position least squares, the ``|a| = g`` fit, sessions from a log
 positions     the positions file of an accelerometer session (``gravity``, ``[[position]]`` tables), keys checked
 ferraris      Ferraris sessions (six faces and three turns, as imucal records them): accelerometer and gyro
+statics       the static-interval detector (imu_tk's moving variance), the initial static period
+gyro          gyro (and accelerometer) from rotations between static poses, no rate table (imu_tk's method)
+gyrofit       its least-squares core: gravity directions after integration, covariance, observability
+gyrochecks    its refusals: too few poses, short or moving poses, rotations at the gyro's range
+gyroframe     a multi-position calibration turned into the system frame (rate-table result or mounting)
+posesim       simulated multi-position sessions of known truth (analytic attitude)
 ellipsoid     algebraic ellipsoid fits and the soft-iron parametrisation
 magnetometer  MagCalibration (the ``imu-align.magnetometer`` file): hard and soft iron with gates,
               rotation to the accelerometer frame from gravity
@@ -18,7 +24,8 @@ Public names
 Calibration, CalibrationSet, SENSORS, FACES, face_ups, static_means, accel_session, calibrate_accel_log,
 StaticDetector, calibrate_accel, Position, parse_positions, positions_of,
 calibrate_accel_free, ferraris, sections_from_dict, SECTIONS, MagCalibration, calibrate_magnetometer, with_gravity_alignment,
-alignment_to_gravity, misalignment_from_axes_down, MODELS
+alignment_to_gravity, misalignment_from_axes_down, MODELS, GyroSession, RotationReport, calibrate_gyro_session,
+in_system_frame, session_intervals
 """
 
 from align.calibration.accel import (
@@ -29,10 +36,13 @@ from align.calibration.accel import (
                                      calibrate_accel_free,
                                      calibrate_accel_log,
                                      face_ups,
+                                     session_intervals,
                                      static_means,
 )
 from align.calibration.ellipsoid import MODELS
 from align.calibration.ferraris import SECTIONS, ferraris, sections_from_dict
+from align.calibration.gyro import GyroSession, RotationReport, calibrate_gyro_session
+from align.calibration.gyroframe import in_system_frame
 from align.calibration.magnetometer import (
                                      MagCalibration,
                                      alignment_to_gravity,
@@ -47,4 +57,5 @@ __all__ = ["Calibration", "CalibrationSet", "SENSORS", "FACES", "face_ups", "sta
            "calibrate_accel_log", "StaticDetector", "Position", "parse_positions", "positions_of",
            "calibrate_accel", "calibrate_accel_free", "ferraris", "sections_from_dict", "SECTIONS", "MagCalibration",
            "calibrate_magnetometer", "with_gravity_alignment", "alignment_to_gravity",
-           "misalignment_from_axes_down", "MODELS"]
+           "misalignment_from_axes_down", "MODELS", "GyroSession", "RotationReport", "calibrate_gyro_session",
+           "in_system_frame", "session_intervals"]

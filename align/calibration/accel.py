@@ -16,7 +16,7 @@ The accelerometer shares the alignment convention ``raw = M true + bias``
 Public names
 ------------
 FACES, face_ups, static_means, norms_at_rest, accel_session, calibrate_accel_log, StaticDetector, calibrate_accel,
-calibrate_accel_free
+calibrate_accel_free, session_intervals
 """
 
 from __future__ import annotations
@@ -103,12 +103,16 @@ def norms_at_rest(x: np.ndarray, ranges: dict) -> np.ndarray:
 class StaticDetector:
     """Settings of the static-interval detector (imu_tk's moving variance, see
     :func:`align.calibration.statics.static_intervals`): window (s), threshold factor,
-    initial static period (s, or None) and shortest interval (s)."""
+    initial static period (s, or None) and shortest interval (s); for a session with a gyro
+    (:mod:`align.calibration.gyro`) the gyro's threshold factor too (a pose held by hand wobbles
+    the gyro's variance up to about 100 times its value at rest; the slow start of a turn that the
+    accelerometer misses raises it thousands of times)."""
 
     window_s: float = 1.0
     factor: float = 6.0
     init_static_s: float | None = None
     min_static_s: float = 1.0
+    gyro_factor: float = 1000.0
 
 
 def calibrate_accel_log(t: np.ndarray, a: np.ndarray, spec: dict | None, units: str, gravity: float | None = None,
@@ -142,6 +146,19 @@ def calibrate_accel_log(t: np.ndarray, a: np.ndarray, spec: dict | None, units: 
     fs = 1.0 / float(np.median(np.diff(t)))
     intervals = static_intervals(a, fs, detector.window_s, detector.factor, detector.init_static_s, detector.min_static_s)
     return accel_session(t, a, intervals, positions, gravity, units, where, positions_file)
+
+
+def session_intervals(t: np.ndarray, a: np.ndarray, spec: dict | None, detector: StaticDetector = StaticDetector(),
+                      positions_file: str = "positions") -> list[tuple[int, int]]:
+    """The static ranges a session from :func:`calibrate_accel_log` uses (its positions' ``start``/``end``
+    when the file gives them, else the detected intervals), as ``(start, end)`` samples, end exclusive:
+    what a picture of the session shows."""
+    if spec is not None:
+        parsed = parse_positions(positions_of(spec, positions_file), positions_file)
+        if parsed[0].samples is not None:
+            return [p.samples for p in parsed]
+    fs = 1.0 / float(np.median(np.diff(t)))
+    return static_intervals(a, fs, detector.window_s, detector.factor, detector.init_static_s, detector.min_static_s)
 
 
 def accel_session(t: np.ndarray, a: np.ndarray, intervals: list, positions: list | None, gravity: float,

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from align.errors import InputError
-from align.io.export import imucal_dict
+from align.io.export import imucal_dict, matrix_unit
 from align.io.keys import check_keys
 from align.plausible import check_usable_model
 from align.results import Result, file_unit
@@ -46,7 +46,8 @@ class Calibration(Value):
     sensor : str
         ``"accelerometer"`` or ``"gyroscope"``.
     M : ndarray, shape (3, 3)
-        Dimensionless; row ``i`` is sensor axis ``i`` times its scale factor.
+        Dimensionless, or counts per SI unit for readings in counts (the file's ``units.M`` says which);
+        row ``i`` is sensor axis ``i`` times its scale factor.
     bias : ndarray, shape (3,)
         SI (m/s^2, rad/s) or counts.
     sigma_M, sigma_bias : ndarray, shape (3, 3) and (3,)
@@ -85,7 +86,7 @@ class Calibration(Value):
         u = self.units
         d = {
             "sensor": self.sensor, "method": self.method, "convention": CONVENTION,
-            "units": {"M": "1", "bias": u, "residuals": u},
+            "units": {"M": matrix_unit(u, self.sensor), "bias": u, "residuals": u},
             "M": self.M.tolist(), "A": np.linalg.inv(self.M).tolist(),
             "bias": to_unit(self.bias, u).tolist(),
             "uncertainty": {"level": "1 sigma", "M": self.sigma_M.tolist(), "bias": to_unit(self.sigma_bias, u).tolist()},

@@ -2,7 +2,7 @@
 
 Public names
 ------------
-static_intervals
+static_intervals, initial_static_period, common_intervals
 """
 
 from __future__ import annotations
@@ -44,3 +44,44 @@ def static_intervals(x: np.ndarray, fs: float, window_s: float = 1.0, factor: fl
         if b - a >= min_duration_s * fs:
             out.append((a, b))
     return out
+
+
+def initial_static_period(x: np.ndarray, fs: float, window_s: float = 1.0, factor: float = 6.0,
+                          min_duration_s: float = 1.0, where: str = "log") -> float:
+    """Length (s) of the static period a record starts with, for a detector without a given one.
+
+    The record's quiet windows (``factor`` times the median variance of its quietest tenth, as
+    :func:`static_intervals` without ``init_static_s``) are found; the first run must start within a
+    window of the first sample. Its length, half a window added back at each end, is the initial period
+    that :func:`static_intervals` then takes its threshold from (imu_tk's ``T_init``).
+
+    Raises
+    ------
+    TestError
+        The record does not start at rest.
+    """
+    from align.errors import TestError
+
+    runs = static_intervals(x, fs, window_s, factor, None, min_duration_s)
+    w = max(3, int(round(window_s * fs)))
+    if not runs or runs[0][0] > w:
+        moving = runs[0][0] / fs if runs else len(x) / fs
+        raise TestError(f"the record does not start at rest (the first {moving:.1f} s move): the initial static period "
+                        "gives the gyro bias and the static threshold; record one first, or give its length with "
+                        "{init_static_s}", where)
+    return (runs[0][1] + w // 2) / fs
+
+
+def common_intervals(first: list, second: list, min_samples: int) -> list[tuple[int, int]]:
+    """The sample ranges inside an interval of both lists (``(start, end)``, end exclusive), at least
+    ``min_samples`` long: static for two sensors at once."""
+    if not first or not second:
+        return []
+    n = max(first[-1][1], second[-1][1])
+    both = np.zeros(n, dtype=bool)
+    for a, b in first:
+        both[a:b] = True
+    other = np.zeros(n, dtype=bool)
+    for a, b in second:
+        other[a:b] = True
+    return [(a, b) for a, b in true_runs(both & other) if b - a >= min_samples]

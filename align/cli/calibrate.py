@@ -78,13 +78,14 @@ def accel(
                              "TIME", DURATION, "'50 s'") = None,
     min_static: opt.Quantity("--min-static", "time", "Shortest static interval.", "TIME", DURATION, "'1 s'") = "1 s",
     json_out: opt.JsonOut = None,
+    plot: opt.OptInput("--plot", "Picture of the static intervals (PNG).", "OUT.png") = None,
     skip_rows: opt.SkipRows = 0,
     comment: opt.Comment = None,
     delimiter: opt.Delimiter = None,
     time_units: opt.TimeUnits = None,
 ) -> None:
     """Accelerometer multi-position calibration (known orientations, or |a| = g over many attitudes)."""
-    check_outputs([log, positions], json_out=json_out)
+    check_outputs([log, positions], json_out=json_out, plot=plot)
     import align.io as fileio
     from align.calibration import CalibrationSet, StaticDetector, calibrate_accel_log
     from align.present.text import calibration_summary
@@ -96,13 +97,23 @@ def accel(
                                  counts=True)  # an accelerometer may be calibrated in its counts
     spec = fileio.read_toml(positions) if positions is not None else None
     g = None if gravity is None else parse_quantity(gravity, "acceleration", "{gravity}")
-    cal = calibrate_accel_log(got.t, got.data, spec, got.shown, g, StaticDetector(window, factor, init_static, min_static),
-                              str(log), str(positions))
-    result = CalibrationSet({"accelerometer": cal}, {"log": str(log), "positions": None if positions is None else
-                                                     str(positions), "accel_units": accel_units, **got.inputs()})
+    detector = StaticDetector(window, factor, init_static, min_static)
+    cal = calibrate_accel_log(got.t, got.data, spec, got.shown, g, detector, str(log), str(positions))
+    # how the log was read and the detector set: what the report needs to draw the session again
+    result = CalibrationSet({"accelerometer": cal}, {
+        "log": str(log), "positions": None if positions is None else str(positions), "accel_units": accel_units,
+        "columns": columns, "rate_hz": rate_hz, "detector": {"window_s": window, "factor": factor,
+                                                             "init_static_s": init_static, "min_static_s": min_static},
+        **got.inputs()})
     with outputs() as out:
         if json_out is not None:
             out.write_json(json_out, result)
+        if plot is not None:
+            from align.calibration.accel import session_intervals
+            from align.present.calplots import accel_statics_png
+
+            used = session_intervals(got.t, got.data, spec, detector, str(positions))
+            out.write_bytes(plot, accel_statics_png(got.t, got.data, used, got.shown))
     typer.echo(calibration_summary(result.sensors))
 
 
@@ -118,15 +129,27 @@ def mag(
                            optional=True) = None,
     dip: opt.OptQuantity("--dip", "angle", "Magnetic dip for the heading-error prediction when no accelerometer "
                          "(-90 to 90 deg).", "ANGLE", DIP, "'60 deg'") = None,
+    axis_down: Annotated[str | None, typer.Option("--axis-down", metavar="x=FILE,y=FILE,z=FILE", help=(
+        "Misalignment to the body axes from turns with each axis pointing down (seed 004): the device turned on a "
+        "flat surface through a full turn with x, then y, then z down; each a file with the same columns, or samples "
+        "of LOG as START:STOP (counted from 0, STOP exclusive; left out of the ellipsoid fit), e.g. "
+        "'x=100:900,y=1000:1800,z=2000:2800'."))] = None,
+    plot: opt.OptInput("--plot", "Picture of the capture before and after, and the heading error (PNG).",
+                       "OUT.png") = None,
     json_out: opt.JsonOut = None,
     skip_rows: opt.SkipRows = 0,
     comment: opt.Comment = None,
     delimiter: opt.Delimiter = None,
 ) -> None:
-    """Magnetometer hard and soft iron (ellipsoid fit with coverage gates)."""
-    check_outputs([log], json_out=json_out)
+    """Magnetometer hard and soft iron (ellipsoid fit with coverage gates), and the misalignment from axis-down turns."""
+    from align.calibration.axisdown import parse_axis_down
+
+    spec = None if axis_down is None else parse_axis_down(axis_down)
+    files = [v for v in (spec or {}).values() if isinstance(v, str)]
+    check_outputs([log, *files], json_out=json_out, plot=plot)
     import align.io as fileio
     from align.calibration import calibrate_magnetometer, with_gravity_alignment
+    from align.calibration.axisdown import axis_down_captures, with_axis_down
     from align.errors import InputError
     from align.io.logs import check_readings
     from align.present.text import magnetometer_summary
@@ -134,26 +157,47 @@ def mag(
 
     fmt = opt.log_format(skip_rows, comment, delimiter)
     scale, shown = parse_scale(mag_units, "magnetic_field", "{mag_units}")
-    _, data = fileio.read_columns(log, names(columns) + (names(accel_columns) if accel_columns else []), log_format=fmt)
+    wanted = names(columns) + (names(accel_columns) if accel_columns else [])
+    _, data = fileio.read_columns(log, wanted, log_format=fmt)
     check_readings(data, str(log))
-    m = data[:, :3] * scale
-    acc = data[:, 3:6] if accel_columns else None
+    def read(path):  # an axis-down capture file: the log's columns, checked as the log is
+        got = fileio.read_columns(path, wanted, log_format=fmt)[1]
+        check_readings(got, str(path))
+        return got
+
+    captures, tumble = {}, data
+    if spec is not None:
+        captures, tumble = axis_down_captures(spec, data, str(log), read)
+    m = tumble[:, :3] * scale
+    acc = tumble[:, 3:6] if accel_columns else None
     f = None if field is None else parse_quantity(field, "counts" if shown == "counts" else "magnetic_field", "{field}")
     if f is not None and not f > 0:
         raise InputError("give a field strength > 0, e.g. '48.5 uT'", "{field}")
     cal = calibrate_magnetometer(m, shown, f, value(model), acc, dip, where=str(log))
-    if acc is not None:
+    if spec is not None:
+        cal = with_axis_down(cal, {a: c[0][:, :3] * scale for a, c in captures.items()},
+                             {a: c[0][:, 3:6] for a, c in captures.items()} if accel_columns else None,
+                             {a: c[1] for a, c in captures.items()})
+    elif acc is not None:
         cal = with_gravity_alignment(cal, m, acc)
-    cal = cal.replace(inputs={"log": str(log), "columns": columns, "mag_units": mag_units, **fmt.to_dict()})
+    cal = cal.replace(inputs={"log": str(log), "columns": columns, "mag_units": mag_units, **fmt.to_dict(),
+                              **({"axis_down": axis_down} if axis_down is not None else {})})
     with outputs() as out:
         if json_out is not None:
             out.write_json(json_out, cal)
+        if plot is not None:
+            from align.present.calplots import magnetometer_png
+
+            out.write_bytes(plot, magnetometer_png(m, cal))
     typer.echo(magnetometer_summary(cal))
 
 
-COMMANDS = {"ferraris": ferraris, "accel": accel, "mag": mag}
+from align.cli.gyrocal import gyro  # noqa: E402  (the command lives in its own module)
 
-app = typer.Typer(help="Sensor calibration: Ferraris sessions, accelerometer positions, magnetometer ellipsoid.",
+COMMANDS = {"ferraris": ferraris, "accel": accel, "mag": mag, "gyro": gyro}
+
+app = typer.Typer(help="Sensor calibration: Ferraris sessions, accelerometer positions, magnetometer ellipsoid, gyro "
+                       "without a rate table.",
                   add_completion=False, rich_markup_mode=None, pretty_exceptions_enable=False)
 for _name, _command in COMMANDS.items():
     app.command(_name)(_command)

@@ -1,4 +1,5 @@
-"""The ``simulate`` command: rate-table sessions with known truth, to rehearse an alignment.
+"""The ``simulate`` command: rate-table sessions with known truth, to rehearse an alignment; and (``--kind poses``)
+multi-position sessions without a rate table, to rehearse ``calibrate gyro``.
 
 Besides the textbook session it makes the sessions real benches produce: an IMU mounted turned in the
 system (``--mounting``), the table's spin axis horizontal (``--table-axis``), Earth's rate
@@ -27,6 +28,8 @@ from align.cli.paths import check_outputs, outputs
 
 #: the written time column's unit -> units in one second
 TIME_UNITS = {"s": 1.0, "ms": 1e3, "us": 1e6, "ns": 1e9}
+#: ``--turn-axes`` of a poses session (:data:`align.calibration.posesim.TURN_AXES`, not imported: the CLI starts light)
+TURN_AXES = ("any", "x", "y", "z", "xy", "xz", "yz", "xyz")
 #: table-axis directions (``[test] table_axis``)
 TABLE_AXES = ("up", "down", "north", "south", "east", "west")
 
@@ -130,7 +133,9 @@ def _choice(text: str, values: tuple[str, ...], what: str) -> str:
 def simulate(
     out_dir: opt.Arg("Folder for session.csv, plan.toml and truth.json (created if missing).", "OUT_DIR"),
     plan: opt.OptInput("--plan", "Plan to run ([[step]] tables); default the six-dwell +/- rate plan.", "PLAN.toml") = None,
-    kind: opt.Choice("--kind", ("rate", "angle"), "The default plan's kind.") = "rate",
+    kind: opt.Choice("--kind", ("rate", "angle", "poses"), "The default plan's kind, or 'poses': a multi-position "
+                     "session without a rate table (static poses reached by free rotations; accelerometer and gyro; "
+                     "for calibrate gyro).") = "rate",
     rate: opt.Quantity("--rate", "angular_rate", "Table rate of the default rate plan.", "RATE", POSITIVE,
                        "'100 deg/s'") = "100 deg/s",
     angle: opt.Quantity("--angle", "angle", "Turn of the default angle plan.", "ANGLE", NONZERO, "'360 deg'") = "360 deg",
@@ -161,8 +166,26 @@ def simulate(
     seed: opt.Seed = 0,
     gyro_units: opt.GyroUnits("Unit of the written gyro columns.") = "deg/s",
     time_units: opt.Choice("--time-units", tuple(TIME_UNITS), "Unit of the written time column (named time).") = "s",
+    poses: opt.Whole("--poses", "With --kind poses: static poses, the initial one included.", 2, 10000, "20") = 20,
+    pose_time: opt.Quantity("--pose-time", "time", "With --kind poses: length of each pose after the first.", "TIME",
+                            DURATION, "'4 s'") = "4 s",
+    turn_time: opt.Quantity("--turn-time", "time", "With --kind poses: length of each rotation.", "TIME", DURATION,
+                            "'2.5 s'") = "2.5 s",
+    turn_axes: opt.Choice("--turn-axes", TURN_AXES, "With --kind poses: 'any' (each rotation about two random axes at "
+                          "once), or the body axes to turn about in turn ('xy' never turns about z: a weakly determined "
+                          "column).") = "any",
+    wobble: opt.Number("--wobble", "With --kind poses and --turn-axes other than any: tilt of each rotation axis (a "
+                       "hand's imprecision, radians; 0: exact axes).", NONNEGATIVE, "0.03", "SIZE") = 0.03,
+    accel_noise: opt.Quantity("--accel-noise", "velocity_random_walk", "With --kind poses: accelerometer white noise.",
+                              "VRW", NONNEGATIVE, "'0.002 m/s^2/sqrt(Hz)'") = "0.002 m/s^2/sqrt(Hz)",
 ) -> None:
-    """Simulate a rate-table session with known M (for rehearsals and examples)."""
+    """Simulate a rate-table session with known M, or (--kind poses) a multi-position session (for rehearsals)."""
+    if value(kind) == "poses":
+        return _simulate_poses(out_dir, rate_hz, head, noise, accel_noise, misalignment, seed, gyro_units, time_units,
+                               poses, pose_time, turn_time, value(turn_axes), wobble,
+                               {"--plan": plan is not None, "--mounting": mounting is not None,
+                                "--latitude": latitude is not None, "--table-axis": table_axis is not None,
+                                "--reorient": reorient, "--flicker": flicker > 0, "--bias-walk": bias_walk > 0})
     names = ("session.csv", "plan.toml", "truth.json")
     check_outputs([plan], folder=("out_dir", out_dir, names))
     import dataclasses
@@ -208,6 +231,50 @@ def simulate(
                                                            run.moves, run.bias.mean(axis=0)))
     moves = f", {len(run.moves)} re-orientation moves" if run.moves else ""
     typer.echo(f"wrote {out_dir}/session.csv ({len(run.t)} rows, {run.t[-1]:.1f} s{moves}), plan.toml and truth.json")
+
+
+def _simulate_poses(out_dir, rate_hz: float, head: float | None, noise: float, accel_noise: float, misalignment: float,
+                    seed: int, gyro_units: str, time_units, poses: int, pose_time: float, turn_time: float,
+                    turn_axes: str, wobble: float, given: dict) -> None:
+    """``--kind poses``: session.csv (time, acc_x..z in m/s^2, gyr_x..z) and truth.json, a calibration file of the
+    true accelerometer and gyro in the accelerometer frame (the frame ``calibrate gyro`` reports), the body-frame
+    truth in its inputs."""
+    from align.errors import InputError
+
+    for flag, on in given.items():
+        if on:
+            raise InputError(f"{flag} belongs to a rate-table session, not to --kind poses; leave it out", "{kind}")
+    names = ("session.csv", "truth.json")
+    check_outputs([], folder=("out_dir", out_dir, names))
+    import numpy as np
+
+    from align.calibration import Calibration, CalibrationSet
+    from align.calibration.posesim import PoseSessionSpec, accel_frame_truth, random_sensors, simulate_poses
+    from align.units import parse_unit, to_unit
+
+    parse_unit(gyro_units, "angular_rate", "{gyro_units}")
+    rng = np.random.default_rng(seed)
+    m_a, b_a, m_g, b_g = random_sensors(rng, misalignment)
+    spec = PoseSessionSpec(fs=rate_hz, poses=poses, init_s=30.0 if head is None else head, pose_s=pose_time,
+                           turn_s=turn_time, axes=turn_axes, wobble=wobble, gyro_noise=noise, accel_noise=accel_noise)
+    run = simulate_poses(spec, m_a, b_a, m_g, b_g, rng)
+    t_acc, g_acc, q = accel_frame_truth(m_a, m_g)
+    zero = np.zeros((3, 3))
+    method = "simulation truth (accelerometer frame: x along the accelerometer's x axis, y in its x-y plane)"
+    truth = CalibrationSet(
+        {"accelerometer": Calibration("accelerometer", t_acc, b_a, zero, np.zeros(3), "m/s^2", method),
+         "gyroscope": Calibration("gyroscope", g_acc, b_g, zero, np.zeros(3), gyro_units, method)},
+        {"seed": seed, "kind": "poses", "rate_hz": rate_hz, "turn_axes": turn_axes, "poses": [list(p) for p in run.poses],
+         "body_frame": {"accelerometer_M": m_a.tolist(), "gyroscope_M": m_g.tolist(), "Q": q.tolist(),
+                        "note": "M_accel_frame = M_body Q^T (gyro), M_a = T Q (RQ decomposition)"},
+         "time_units": value(time_units)})
+    unit = value(time_units)
+    with outputs() as out:
+        out.folder(out_dir)
+        out.write_csv(out_dir / names[0], ["time", "acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z"],
+                      np.column_stack([run.t * TIME_UNITS[unit], run.acc, to_unit(run.gyr, gyro_units)]))
+        out.write_json(out_dir / names[1], truth)
+    typer.echo(f"wrote {out_dir}/session.csv ({len(run.t)} rows, {run.t[-1]:.1f} s, {poses} poses) and truth.json")
 
 
 def _default_plan(kind: str, rate: float, angle: float, table_axis: str, latitude: float | None):

@@ -319,7 +319,7 @@ def _statics_picture(inputs: dict, cal):
     """The static intervals of an accelerometer session, detected again from the log the calibration names."""
     if cal.sensor != "accelerometer" or "positions" not in inputs:
         return None, ""
-    from align.calibration.statics import static_intervals
+    from align.calibration.accel import StaticDetector, session_intervals
     from align.io import read_sensor_log
     from align.present.calplots import accel_statics_png
 
@@ -333,9 +333,12 @@ def _statics_picture(inputs: dict, cal):
     except (AlignError, KeyError) as exc:
         return None, f"no picture: the log could not be read again ({exc})"
     det = inputs.get("detector") or {}
-    fs = 1.0 / float(np.median(np.diff(got.t)))
-    iv = static_intervals(got.data, fs, det.get("window_s", 1.0), det.get("factor", 6.0), det.get("init_static_s"),
-                          det.get("min_static_s", 1.0))
+    detector = StaticDetector(**{k: det[k] for k in ("window_s", "factor", "init_static_s", "min_static_s") if k in det})
+    try:
+        spec = None if inputs.get("positions") is None else read_toml(inputs["positions"])
+        iv = session_intervals(got.t, got.data, spec, detector, str(inputs.get("positions")))
+    except AlignError as exc:
+        return None, f"no picture: the session's intervals could not be found again ({exc})"
     note = "" if det else "static intervals detected again with the default detector settings (the file records none)"
     return accel_statics_png(got.t, got.data, iv, cal.units), note
 

@@ -313,7 +313,8 @@ def calibration_summary(cals: dict) -> str:
         out += ["  angles of M's rows (sensor axes) in the calibration frame [deg]:", *angle_lines(angles(c.M), None, "    ")]
         if d["residuals"]:
             worst = max(d["residuals"].items(), key=lambda kv: float(np.max(np.abs(kv[1]))))
-            out.append(f"  largest residual: {worst[0]} {np.max(np.abs(worst[1])):.3g} {u} ({len(d['residuals'])} positions)")
+            what = "rotations" if all(k.startswith("rotation ") for k in d["residuals"]) else "positions"
+            out.append(f"  largest residual: {worst[0]} {np.max(np.abs(worst[1])):.3g} {u} ({len(d['residuals'])} {what})")
         for k, v in d["checks"].items():
             out.append(f"  held-out check {k}: residual {np.max(np.abs(v)):.3g} {u}")
         out += [f"  note: {n}" for n in d["notes"]] + [""]
