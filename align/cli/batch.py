@@ -1,8 +1,326 @@
 """``imu-align batch`` and ``imu-align lot``: many units through the single commands, and their statistics.
 
+``batch`` runs every unit of a manifest (:mod:`align.production.manifest`) through the very command
+a user would type for it alone: a worker calls :func:`align.cli.run` in its own process with the
+unit's words (``matrix LOG --plan PLAN ... --json OUT/units/SERIAL.json``), its output captured, and
+records the exit status and the command's one-line error against the serial; the unit's JSON,
+written atomically by the command itself, is read back for the lot's table. No job is run any
+other way, so a unit's result and its refusal are exactly the single command's.
+
 Public names
 ------------
-COMMANDS
+batch, lot, run_unit, simulate_lot_command, JOBS, COMMANDS
 """
 
-COMMANDS: dict = {}
+from __future__ import annotations
+
+import io
+import sys
+import threading
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from align.cli import options as opt
+
+#: job -> (the option its manifest ``plan`` column is given as, whether it needs one)
+JOBS: dict[str, tuple[str | None, str]] = {
+    "matrix": ("--plan", "required"),
+    "calibrate ferraris": ("--sections", "required"),
+    "calibrate accel": ("--positions", "optional"),
+    "calibrate mag": (None, "none"),
+    "calibrate gyro": (None, "none"),
+    "allan": (None, "none"),
+}
+#: options the batch gives every unit itself
+RESERVED = ("--json", "--help", "--version")
+#: options naming files a command writes (not inputs: they do not enter the content hash)
+OUTPUT_OPTIONS = ("--c-header", "--plot", "--imucal-json", "--json")
+
+
+def _jobs() -> dict[str, str]:
+    """The jobs this installation has, each with its use of the plan column."""
+    from align.cli import COMMANDS
+
+    have = {name if not subs else f"{name} {s}" for name, subs in COMMANDS.items() for s in (subs or (None,))}
+    return {job: use for job, (_, use) in JOBS.items() if job in have}
+
+
+def _command(job: str):
+    from align.cli import alignment, calibrate, noise
+
+    words = job.split()
+    return calibrate.COMMANDS[words[1]] if words[0] == "calibrate" else {**alignment.COMMANDS, **noise.COMMANDS}[words[0]]
+
+
+def _path_options(job: str) -> set[str]:
+    """The options of ``job`` whose value is a file (``--segments``, ``--plot``): resolved against the manifest."""
+    import typing
+
+    found: set[str] = set()
+    for hint in typing.get_type_hints(_command(job), include_extras=True).values():
+        if typing.get_origin(hint) is not Annotated:
+            continue
+        base, *meta = typing.get_args(hint)
+        if Path in (typing.get_args(base) or (base,)):
+            for m in meta:  # typer.Option("--plot", ...) in Annotated: the flag is its first argument, "default"
+                names = [getattr(m, "default", None), *(getattr(m, "param_decls", ()) or ())]
+                found |= {d for d in names if isinstance(d, str) and d.startswith("--")}
+    return found
+
+
+def _resolved(options: tuple[str, ...], files: set[str], folder: Path) -> tuple[list[str], list[Path]]:
+    """The options with file values made absolute (relative to ``folder``), and the input files among them."""
+    out, inputs, i = [], [], 0
+    while i < len(options):
+        word = options[i]
+        name, eq, text = word.partition("=")
+        if name in files and (eq or i + 1 < len(options)):
+            value = text if eq else options[i + 1]
+            path = (folder / value).resolve()
+            out += [f"{name}={path}"] if eq else [name, str(path)]
+            if name not in OUTPUT_OPTIONS:
+                inputs.append(path)
+            i += 1 if eq else 2
+            continue
+        out.append(word)
+        i += 1
+    return out, inputs
+
+
+def _task_maker(folder: Path):
+    from align.production import Task
+
+    files = {job: _path_options(job) for job in _jobs()}
+
+    def make(unit, result: Path, run: str) -> Task:
+        flag = JOBS[unit.job][0]
+        options, inputs = _resolved(unit.options, files[unit.job], folder)
+        args = [*unit.job.split(), str(unit.log)]
+        if unit.plan is not None:
+            args += [flag, str(unit.plan)]
+        args += [*options, "--json", str(result.resolve())]
+        return Task(unit, tuple(args), result.resolve(), (unit.log, unit.plan, *inputs), run)
+
+    return make
+
+
+# ---- the worker: the single command, run in this process with its output captured ----
+
+class _Local(threading.local):
+    out: io.StringIO | None = None
+    err: io.StringIO | None = None
+
+
+_LOCAL = _Local()
+
+
+class _Routed(io.TextIOBase):
+    """A stream that writes to this thread's capture buffer while a unit runs, else to the real stream
+    (a Dask worker runs units in several threads at once)."""
+
+    def __init__(self, real, which: str) -> None:
+        self.real, self.which = real, which
+
+    def _target(self):
+        return getattr(_LOCAL, self.which) or self.real
+
+    def write(self, text: str) -> int:
+        return self._target().write(text)
+
+    def flush(self) -> None:
+        self._target().flush()
+
+    def isatty(self) -> bool:  # no progress bar inside a unit
+        return False if getattr(_LOCAL, self.which) is not None else self.real.isatty()
+
+    @property
+    def encoding(self) -> str:
+        return "utf-8"
+
+
+_ROUTE_LOCK = threading.Lock()
+
+
+def _capture() -> None:
+    with _ROUTE_LOCK:
+        if not isinstance(sys.stdout, _Routed):
+            sys.stdout = _Routed(sys.stdout, "out")
+        if not isinstance(sys.stderr, _Routed):
+            sys.stderr = _Routed(sys.stderr, "err")
+
+
+def run_unit(task) -> list[dict]:
+    """Run one unit's single command in this process (:func:`align.cli.run`) and return its table rows.
+
+    The command's stdout is dropped, its stderr (one line on a failure) becomes the unit's message.
+    """
+    import time
+
+    from align.cli import run
+    from align.production import unit_rows
+
+    _capture()
+    digest = task.digest()
+    _LOCAL.out, _LOCAL.err = io.StringIO(), io.StringIO()
+    started = time.perf_counter()
+    try:
+        code = run(list(task.args))
+    finally:
+        err = _LOCAL.err.getvalue()
+        _LOCAL.out = _LOCAL.err = None
+    return unit_rows(task, code, " ".join(err.split()), digest, time.perf_counter() - started)
+
+
+# ---- the commands ----
+
+Workers = Annotated[int | None, typer.Option("--workers", parser=opt.whole(1, 4096, "2"), metavar="N", help=(
+    "Worker processes on this machine, or of a local Dask cluster (--scheduler local); default: the CPUs."))]
+Scheduler = Annotated[str | None, typer.Option("--scheduler", metavar="ADDRESS", help=(
+    "Run on a Dask cluster instead of a process pool: its scheduler (tcp://host:8786), or 'local' for a local "
+    "cluster of --workers processes. Needs pip install 'imu-align[cluster]'; the workers must see the files under "
+    "the same paths."))]
+
+
+def batch(
+    manifest: opt.Arg("Manifest: CSV with columns serial, job, log, plan, options and optionally slot, or TOML "
+                      "([[unit]] tables, [defaults]); paths relative to it. Jobs: matrix (plan: its --plan), "
+                      "calibrate ferraris (--sections), calibrate accel (--positions), calibrate mag, calibrate gyro, "
+                      "allan; options as the single command takes them.", "MANIFEST"),
+    workers: Workers = None,
+    scheduler: Scheduler = None,
+    out: opt.OptInput("--out", "Output folder: units/SERIAL.json and results.parquet (default: the manifest's "
+                      "folder).", "DIR") = None,
+    spec: opt.OptInput("--spec", "Limits per figure (TOML), to judge each unit as it finishes.", "SPEC.toml") = None,
+) -> None:
+    """Run every unit of a manifest through its single command (matrix, calibrate ..., allan), in parallel.
+
+    Each unit's result goes to OUT/units/SERIAL.json, its key figures to OUT/results.parquet (appended). A rerun
+    skips units whose result is there and whose inputs are unchanged. Exit status: 0 every unit ran (and passed
+    the spec); 3 some units failed or gave an error; 4 some units are outside the spec.
+    """
+    import os
+    import time
+
+    from align.cli.paths import output_folder
+    from align.cli.progress import progress
+    from align.errors import CheckFailed, InputError, TestError
+    from align.present.lot import batch_summary
+    from align.production import TABLE, BatchRun, judge_rows, make_pool, plan_tasks, read_manifest, read_spec, run_units
+    from align.production.batch import locked
+    from align.production.stats import rejudge_rows
+    from align.production.table import now
+
+    if scheduler is not None and scheduler != "local" and workers is not None:
+        raise InputError("goes with the process pool or a local cluster (--scheduler local); a running cluster has "
+                         "its own workers", "{workers}")
+    jobs = _jobs()
+    lot = read_manifest(manifest, jobs)
+    for unit in lot.units:
+        for word in unit.options:
+            if word.partition("=")[0] in RESERVED:
+                raise InputError(f"{unit.row}, column options: {word.partition('=')[0]} is the batch's own (each "
+                                 "unit's result goes to OUT/units/SERIAL.json); remove it", str(manifest))
+    limits = read_spec(spec) if spec is not None else None
+    folder = out if out is not None else lot.folder
+    created = output_folder("out", folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    pool = make_pool(workers or os.cpu_count() or 1, scheduler)
+    started = time.perf_counter()
+    run = BatchRun(total=len(lot.units))
+    try:
+        with locked(folder):
+            tasks, skipped = plan_tasks(lot.units, folder, _task_maker(lot.folder.resolve()), now().isoformat())
+            run.add(rejudge_rows(skipped, limits), skipped=True)  # judged again: the spec may be another
+            if tasks:
+                with pool, progress(len(tasks), "units") as tick:
+                    run_units(tasks, run_unit, pool, folder, lambda rows: judge_rows(rows, limits), tick, run)
+    except BaseException:
+        if created and not any(folder.iterdir()):  # nothing ran (no cluster, say): leave no folder behind
+            folder.rmdir()
+        raise
+    typer.echo(batch_summary(run, str(manifest), pool.where, folder / TABLE, time.perf_counter() - started))
+    failed = len(run.lot("failed")) + len(run.lot("error"))
+    outside = len(run.lot("ok", "fail"))
+    if failed:
+        raise TestError(f"{failed} of {run.total} units failed or gave an error"
+                        + (f", {outside} outside the spec" if outside else "") + " (listed above)", "batch")
+    if outside:
+        raise CheckFailed(f"{outside} of {run.total} units outside the spec (listed above)", "batch")
+
+
+def lot(
+    table: opt.Arg("The lot's table (results.parquet of imu-align batch).", "TABLE.parquet"),
+    spec: opt.OptInput("--spec", "Limits per figure (TOML): phi_xy = { abs_max = \"0.1 deg\" }, scale_x = { min = "
+                       "0.995, max = 1.005 }, arw_x = { max = \"0.3 deg/sqrt(h)\" }; tables [gyroscope], "
+                       "[accelerometer], [magnetometer] for one sensor.", "SPEC.toml") = None,
+    report: opt.OptInput("--report", "HTML report: failing units first, histograms with the limits, control "
+                         "charts.", "LOT.html") = None,
+    trend: opt.Choice("--trend", ("order", "time"), "Trend over the lot's order (per unit) or time (per day).")
+    = "order",
+) -> None:
+    """Statistics of a lot (each unit's latest run): count, mean, spread, Cpk, yield, outliers, trend.
+
+    Exit status 4 when a unit failed, gave an error or is outside the spec (listed first).
+    """
+    from align.cli.paths import check_outputs, outputs
+
+    check_outputs([table, spec], report=report)
+    from align.errors import CheckFailed
+    from align.io import existing_file
+    from align.present.lot import lot_report_html, lot_summary
+    from align.production import latest_rows, lot_statistics, read_spec, read_table
+    from align.production.stats import figures_needed
+
+    limits = read_spec(spec) if spec is not None else None
+    rows = latest_rows(read_table(existing_file(table)), figures_needed(limits))
+    stats = lot_statistics(rows, limits, opt.value(trend))
+    with outputs() as staged:
+        if report is not None:
+            staged.write_text(report, lot_report_html(stats, str(table)))
+    typer.echo(lot_summary(stats, str(table)))
+    bad = stats.count - stats.passed
+    if bad:
+        raise CheckFailed(f"{bad} of {stats.count} units do not pass (listed first)", str(table))
+
+
+def simulate_lot_command(out_dir: Path, n: int, spread: float, scale_spread: float, bias_spread: float, bad: int,
+                         seed: int, rate: float, dwell: float, gap: float, rate_hz: float, noise: float) -> None:
+    """``imu-align simulate OUT_DIR --lot N ...``: a rehearsal lot (:func:`align.production.simulate_lot`), all or none.
+
+    The lot is written into a temporary folder beside ``out_dir`` and moved into place at the end: a failed
+    or interrupted run leaves nothing. Values arrive in SI (the simulate command's options parse them).
+    """
+    import shutil
+    import tempfile
+
+    from align.alignment.simulate import SessionSpec
+    from align.cli.paths import output_folder
+    from align.errors import InputError
+    from align.production import LotSpread, simulate_lot
+
+    names = ("manifest.csv", "plan.toml", "truth.csv", "sessions")
+    output_folder("out_dir", out_dir)
+    taken = [name for name in names if (out_dir / name).exists()]
+    if taken:
+        raise InputError(f"{out_dir} already holds {taken[0]}; give an empty or new folder", "{out_dir}")
+    spec = SessionSpec(fs=rate_hz, dwell_s=dwell, static_s=gap, noise_density=noise)
+    lot_spread = LotSpread(spread, scale_spread, LotSpread().delta, bias_spread)
+    base = out_dir.resolve()
+    while not base.is_dir():  # the nearest existing folder: staged there, the same file system as the target
+        base = base.parent
+    staging = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=base))
+    try:
+        truth = simulate_lot(staging, n, lot_spread, spec, bad, seed, rate)
+        out_dir.mkdir(parents=True, exist_ok=True)
+        for name in names:
+            (staging / name).rename(out_dir / name)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    listed = ", ".join(f"{u['serial']} ({u['kind']})" for u in truth.units if u["kind"] != "good")
+    typer.echo(f"wrote a lot of {n} units to {out_dir}: sessions/SERIAL.csv, plan.toml, manifest.csv (for imu-align "
+               f"batch) and truth.csv" + (f"; bad units: {listed}" if listed else ""))
+
+
+COMMANDS = {"batch": batch, "lot": lot}

@@ -58,10 +58,10 @@ def drift(
     nav_rate: Annotated[float | None, typer.Option("--nav-rate", parser=hertz, metavar="HZ", help=(
         "Navigation update rate (default 10 Hz, at most the sample rate), Hz, e.g. 10 or '10 Hz'."))] = None,
     turn_rate: opt.Quantity("--turn-rate", "angular_rate", "Mean rate of a manoeuvre's rotations.", "RATE", POSITIVE,
-                            "'10 deg/s'") = 10 * _DEG,
-    heading: opt.Quantity("--heading", "angle", "Initial heading.", "ANGLE", example="'0 deg'") = 0.0,
+                            "'10 deg/s'") = "10 deg/s",
+    heading: opt.Quantity("--heading", "angle", "Initial heading.", "ANGLE", example="'0 deg'") = "0 deg",
     latitude: opt.Quantity("--latitude", "angle", "Latitude (gravity; the Earth rate).", "ANGLE", LATITUDE,
-                           "'45 deg'") = 45 * _DEG,
+                           "'45 deg'") = "45 deg",
     earth_rate: opt.Flag("--earth-rate/--no-earth-rate", "Include the Earth rate and the Coriolis term.") = False,
     gyro_bias: opt.OptQuantity("--gyro-bias", "angular_rate", "Residual gyro turn-on bias, 1 sigma (replaces any other "
                                "source).", "RATE", NONNEGATIVE, "'10 deg/h'") = None,

@@ -178,8 +178,30 @@ def simulate(
                        "hand's imprecision, radians; 0: exact axes).", NONNEGATIVE, "0.03", "SIZE") = 0.03,
     accel_noise: opt.Quantity("--accel-noise", "velocity_random_walk", "With --kind poses: accelerometer white noise.",
                               "VRW", NONNEGATIVE, "'0.002 m/s^2/sqrt(Hz)'") = "0.002 m/s^2/sqrt(Hz)",
+    lot: Annotated[int | None, typer.Option("--lot", parser=opt.whole(1, 1_000_000, "200"), metavar="N", help=(
+        "A lot of N units instead of one session, for imu-align batch: OUT_DIR/manifest.csv, plan.toml, "
+        "sessions/SERIAL.csv and truth.csv; each unit's parameters drawn around the nominal part "
+        "(--spread, --scale-spread, --bias-spread), --bad of them deliberately bad."))] = None,
+    spread: opt.Quantity("--spread", "angle", "Lot: 1-sigma of each component of a unit's mounting rotation.",
+                         "ANGLE", NONNEGATIVE, "'0.03 deg'") = "0.03 deg",
+    scale_spread: opt.Quantity("--scale-spread", "dimensionless", "Lot: 1-sigma of each scale factor about 1.",
+                               "RATIO", NONNEGATIVE, "'0.1 %'") = "0.1 %",
+    bias_spread: opt.Quantity("--bias-spread", "angular_rate", "Lot: 1-sigma of each turn-on bias.", "RATE",
+                              NONNEGATIVE, "'0.2 deg/s'") = "0.2 deg/s",
+    bad: opt.Whole("--bad", "Lot: units made deliberately bad, in turn out of spec (mounted 0.3 deg off), wrong "
+                   "direction (a step turned the other way), NaN rows.", 0, 1_000_000, "5") = 5,
 ) -> None:
-    """Simulate a rate-table session with known M, or (--kind poses) a multi-position session (for rehearsals)."""
+    """Simulate a rate-table session with known M, (--kind poses) a multi-position session, or (--lot) a lot of
+    units for imu-align batch (for rehearsals)."""
+    if lot is not None:
+        from align.cli.batch import simulate_lot_command
+        from align.errors import InputError
+
+        if plan is not None or mounting is not None or latitude is not None or reorient or value(kind) != "rate":
+            raise InputError("goes with one session; a lot runs the six-dwell rate plan (--rate, --dwell, --gap, "
+                             "--rate-hz, --noise, --seed)", "{lot}")
+        return simulate_lot_command(out_dir, lot, spread, scale_spread, bias_spread, bad, seed, rate, dwell, gap,
+                                    rate_hz, noise)
     if value(kind) == "poses":
         return _simulate_poses(out_dir, rate_hz, head, noise, accel_noise, misalignment, seed, gyro_units, time_units,
                                poses, pose_time, turn_time, value(turn_axes), wobble,

@@ -60,7 +60,7 @@ def test_magnetometer_summary_states_the_angles_of_its_m(run_cli, tmp_path):
                   "--json", out)
     assert res.code == 0, res.err
     d = json.loads(out.read_text())
-    assert "soft iron [dimensionless]:" in res.out and "angles of M = (soft_iron)^-1" in res.out
+    assert "soft iron [dimensionless] (± 1 sigma):" in res.out and "angles of M = (soft_iron)^-1" in res.out
     _check(res.out, np.linalg.inv(np.array(d["soft_iron"])))      # m_raw = M m + h: M = soft_iron^-1
 
 

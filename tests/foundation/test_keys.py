@@ -59,6 +59,15 @@ def test_table_and_tables_refuse_the_wrong_shape_in_one_line():
 
 def _reader(data: dict):
     """The reader a bundled TOML is for, told by its tables."""
+    if "unit" in data:  # a lot's manifest
+        from align.cli.batch import _jobs
+        from align.production.manifest import read_manifest
+
+        return lambda d, where, folder: read_manifest(where, _jobs())
+    if any("_" in k and isinstance(v, dict) and v.keys() & {"min", "max", "abs_max"} for k, v in data.items()):
+        from align.production.spec import read_spec
+
+        return lambda d, where, folder: read_spec(where)  # a lot's limits
     if "step" in data:
         return lambda d, where, folder: Plan.from_dict(d, where)
     if "imu" in data:
@@ -78,8 +87,10 @@ def test_every_bundled_input_file_loads_with_its_strict_reader(path):
 
 
 def test_the_bundled_inputs_cover_every_kind():
-    kinds = {("step" in d, "imu" in d, "limits" in d) for d in map(read_toml, BUNDLED)}
-    assert len(BUNDLED) >= 6 and kinds == {(True, False, False), (False, True, False), (False, False, True)}
+    kinds = {("step" in d, "imu" in d, "limits" in d, "unit" in d) for d in map(read_toml, BUNDLED)}
+    assert len(BUNDLED) >= 6 and kinds == {(True, False, False, False), (False, True, False, False),
+                                           (False, False, True, False), (False, False, False, True),
+                                           (False, False, False, False)}  # the last: a lot's spec
 
 
 def test_file_name_resolves_in_the_input_folder_and_refuses_a_non_name(tmp_path):

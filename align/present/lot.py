@@ -1,0 +1,234 @@
+"""A lot for people: the batch's summary, the lot's statistics as text, and its HTML report with pictures.
+
+The report (:func:`lot_report_html`) lists the units that do not pass first, then the statistics of
+every figure against its limit, a histogram per figure with its limits, and an individuals control
+chart per figure over the lot's order (or time) with its control limits and spec limits; pictures
+are matplotlib PNGs embedded as data URIs (:func:`align.present.html.image`).
+
+Public names
+------------
+batch_summary, lot_summary, lot_report_html, histograms_png, control_charts_png
+"""
+
+from __future__ import annotations
+
+import io
+import math
+
+import numpy as np
+
+from align.present.html import Section, esc, html_report, image, table
+
+#: the most panels in one picture
+MAX_PANELS = 24
+
+
+def _num(x: float, signed: bool = False, ref: float | None = None) -> str:
+    """``x`` to 3 significant digits of ``ref`` (a spread: the mean of a ratio near 1 keeps its digits), else 4."""
+    if x is None or not math.isfinite(x):
+        return "-"
+    if ref is not None and math.isfinite(ref) and ref > 0:
+        d = max(0, min(12, 2 - math.floor(math.log10(ref))))
+        return f"{x:+.{d}f}" if signed else f"{x:.{d}f}"
+    return f"{x:+.4g}" if signed else f"{x:.4g}"
+
+
+def _unit(fs) -> str:
+    return "" if fs.unit == "1" else f" {fs.unit}"
+
+
+def _per(stats) -> str:
+    return "per day" if stats.trend_by == "time" else "per 100 units"
+
+
+def _slope(fs, stats) -> tuple[float, float]:
+    k = 1.0 if stats.trend_by == "time" else 100.0
+    return fs.shown(fs.slope * k), fs.shown(fs.slope_sigma * k)
+
+
+def batch_summary(run, manifest: str, where: str, table_path, seconds: float) -> str:
+    """What a batch did, in a few lines: units run and skipped, the lot's counts, time, throughput, and the units
+    that do not pass with their message."""
+    ran = run.units()
+    ok, outside = run.lot("ok"), run.lot("ok", "fail")
+    failed, errors = run.lot("failed"), run.lot("error")
+    lines = [f"batch of {manifest} on {where}: {run.total} units; ran {len(ran)}, skipped {len(run.lot()) - len(ran)} "
+             f"(done before, inputs unchanged); {len(ok)} ok" + (f" ({len(outside)} outside the spec)" if outside else "")
+             + f", {len(failed)} failed, {len(errors)} errors",
+             f"{seconds:.1f} s" + (f", {len(ran) / seconds:.2f} units/s" if ran and seconds > 0 else "")
+             + f"; table {table_path}, results in {table_path.parent / 'units'}"]
+    bad = failed + errors + outside
+    if bad:
+        lines.append(f"units not passing ({len(bad)}):")
+        lines += [f"  {r['serial']:<12} {r['verdict']:<7} {r['message']}" for r in sorted(bad, key=lambda r: r['order'])]
+    return "\n".join(lines)
+
+
+def _stats_rows(stats) -> list[list]:
+    rows = []
+    for fs in stats.figures:
+        s, ss = _slope(fs, stats)
+        ref = fs.shown(fs.std)
+        rows.append([fs.figure, fs.sensor, fs.limit.describe() if fs.limit else "", fs.unit, fs.n,
+                     _num(fs.shown(fs.mean), True, ref), _num(ref, False, ref), _num(fs.shown(fs.minimum), True, ref),
+                     _num(fs.shown(fs.maximum), True, ref),
+                     f"{fs.cpk:.2f} ± {fs.cpk_sigma:.2f}" if fs.limit and math.isfinite(fs.cpk_sigma) else "-",
+                     f"{100 * fs.yield_:.1f} %" if fs.limit else "-", len(fs.outliers),
+                     "-" if not math.isfinite(s) else
+                     f"{_num(s, True, ss)} ± {_num(ss, False, ss)}" + (" *" if abs(s) > 3 * ss else "")])
+    return rows
+
+
+_HEADER = ["figure", "sensor", "limit", "unit", "n", "mean", "std", "min", "max", "Cpk", "yield", "outliers"]
+
+
+def lot_summary(stats, source: str) -> str:
+    """The lot's statistics as text: yield, a table of the figures, the units that do not pass, outliers, trends."""
+    if not stats.count:
+        return f"lot of {source}: no units"
+    spec = f", spec {stats.spec.path}" if stats.spec else " (no spec: no limits, Cpk or yield)"
+    lines = [f"lot of {source}: {stats.count} units (each one's latest run){spec}",
+             f"yield {stats.passed} of {stats.count} = {100 * stats.yield_:.1f} % +/- {100 * stats.yield_sigma:.1f} % "
+             "(units passing every limit; units that failed or gave an error count as not passing)", ""]
+    header = _HEADER + [f"trend {_per(stats)}"]
+    rows = [[str(c) for c in r] for r in _stats_rows(stats)]
+    widths = [max(len(h), *(len(r[i]) for r in rows)) if rows else len(h) for i, h in enumerate(header)]
+    for r in [header] + rows:
+        lines.append("  ".join(c.ljust(w) if i < 4 else c.rjust(w) for i, (c, w) in enumerate(zip(r, widths))).rstrip())
+    lines.append("(* a trend beyond 3 sigma; mean, std, min, max, trend in each figure's unit)")
+    bad = [u for u in stats.units if u.verdict != "pass"]
+    if bad:
+        lines += ["", f"units not passing ({len(bad)}):"]
+        lines += [f"  {u.serial:<12} {u.verdict:<7} {'; '.join(u.reasons)}" for u in bad]
+    outliers: dict[str, list[str]] = {}
+    for fs in stats.figures:
+        for s in fs.outliers:
+            outliers.setdefault(s, []).append(fs.figure)
+    if outliers:
+        lines += ["", "outliers (robust z-score beyond 3.5): "
+                  + ", ".join(f"{s} ({', '.join(f)})" for s, f in outliers.items())]
+    return "\n".join(lines)
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _grid(n: int):
+    plt = _pyplot()
+    cols = min(3, n)
+    rows = math.ceil(n / cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 2.9 * rows), squeeze=False)
+    for ax in axes.flat[n:]:
+        ax.set_visible(False)
+    return plt, fig, list(axes.flat[:n])
+
+
+def _png(plt, fig) -> bytes:
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=90)
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def _limits(ax, fs, vertical: bool) -> None:
+    lim = fs.limit
+    if lim is None:
+        return
+    for b in (lim.low, lim.high):
+        if b is not None:
+            (ax.axvline if vertical else ax.axhline)(fs.shown(b), color="tab:red", ls="--", lw=1.2)
+
+
+def _legend(ax, fs, *lines) -> None:
+    from matplotlib.lines import Line2D
+
+    handles = [Line2D([], [], color=c, ls=ls, label=label) for label, c, ls in lines]
+    if fs.limit is not None:
+        handles.append(Line2D([], [], color="tab:red", ls="--", label="spec limits"))
+    handles.append(Line2D([], [], color="tab:red", marker="o", ls="", label="outside the spec"))
+    ax.legend(handles=handles, fontsize=6, loc="upper right", framealpha=0.8)
+
+
+def histograms_png(stats) -> bytes:
+    """A histogram per figure (at most :data:`MAX_PANELS`) with its spec limits (red dashes) and its mean."""
+    figs = stats.figures[:MAX_PANELS]
+    plt, fig, axes = _grid(len(figs))
+    for ax, fs in zip(axes, figs):
+        v = np.array([fs.shown(x) for x in fs.values])
+        good = np.array([fs.limit.ok(x) if fs.limit else True for x in fs.values])
+        lo, hi = float(np.min(v)), float(np.max(v))
+        if fs.limit is not None:
+            lo = min([lo] + [fs.shown(b) for b in (fs.limit.low, fs.limit.high) if b is not None])
+            hi = max([hi] + [fs.shown(b) for b in (fs.limit.low, fs.limit.high) if b is not None])
+        pad = 0.05 * (hi - lo) or max(abs(lo), 1e-12) * 0.05
+        bins = np.linspace(lo - pad, hi + pad, 31)
+        ax.hist([v[good], v[~good]], bins=bins, stacked=True, color=["tab:blue", "tab:red"],
+                label=["within", "outside"])
+        _limits(ax, fs, True)
+        ax.axvline(fs.shown(fs.mean), color="k", lw=0.8)
+        cpk = f", Cpk {fs.cpk:.2f}" if fs.limit is not None and math.isfinite(fs.cpk) else ""
+        ax.set_title(f"{fs.figure} ({fs.sensor}){cpk}", fontsize=9)
+        if ax is axes[0]:
+            _legend(ax, fs, ("mean", "k", "-"))
+        ax.set_xlabel(fs.unit if fs.unit != "1" else "ratio", fontsize=8)
+        ax.tick_params(labelsize=7)
+    return _png(plt, fig)
+
+
+def control_charts_png(stats) -> bytes:
+    """An individuals chart per figure: each unit over the lot's order (or days), the mean, the control limits
+    (mean -/+ 3 MR/1.128, grey) and the spec limits (red dashes); units outside the spec in red."""
+    figs = stats.figures[:MAX_PANELS]
+    plt, fig, axes = _grid(len(figs))
+    for ax, fs in zip(axes, figs):
+        v = np.array([fs.shown(x) for x in fs.values])
+        bad = np.array([not fs.limit.ok(x) if fs.limit else False for x in fs.values])
+        ax.plot(fs.x, v, "-", color="0.75", lw=0.6)
+        ax.plot(fs.x[~bad], v[~bad], ".", color="tab:blue", ms=3)
+        ax.plot(fs.x[bad], v[bad], "o", color="tab:red", ms=4)
+        ax.axhline(fs.shown(fs.centre), color="k", lw=0.8)
+        for c in (fs.lcl, fs.ucl):
+            if math.isfinite(c):
+                ax.axhline(fs.shown(c), color="0.4", ls=":", lw=1)
+        _limits(ax, fs, False)
+        ax.set_title(f"{fs.figure} ({fs.sensor})", fontsize=9)
+        if ax is axes[0]:
+            _legend(ax, fs, ("mean", "k", "-"), ("control limits", "0.4", ":"))
+        ax.set_xlabel("days since the first unit" if stats.trend_by == "time" else "unit (lot order)", fontsize=8)
+        ax.set_ylabel(fs.unit if fs.unit != "1" else "ratio", fontsize=8)
+        ax.tick_params(labelsize=7)
+    return _png(plt, fig)
+
+
+def lot_report_html(stats, source: str) -> str:
+    """The lot's HTML report (one self-contained page)."""
+    sections = []
+    bad = [u for u in stats.units if u.verdict != "pass"]
+    verdict = "pass" if not bad else "fail"
+    banner = (f'<p class="banner {verdict}">yield {stats.passed} of {stats.count} = {100 * stats.yield_:.1f} % '
+              f"&plusmn; {100 * stats.yield_sigma:.1f} %: " + ("every unit passes" if not bad else
+                                                                f"{len(bad)} units do not pass") + "</p>")
+    sections.append(Section("Summary", banner + '<p class="note">Each unit\'s latest run; units that failed or gave '
+                            "an error count as not passing. Spec: " + esc(stats.spec.path if stats.spec else "none")
+                            + ".</p>"))
+    if bad:
+        rows = [[u.serial, u.job, (u.verdict, "fail"), "; ".join(u.reasons)] for u in bad]
+        sections.append(Section(f"Units not passing ({len(bad)})", table(["serial", "job", "verdict", "why"], rows, 4)))
+    if stats.figures:
+        header = _HEADER + [f"trend {_per(stats)}"]
+        sections.append(Section("Statistics", table(header, _stats_rows(stats), 4) + '<p class="note">Mean, std, '
+                                "min, max and trend in each figure's unit; Cpk &plusmn; its standard error; outliers "
+                                "by the robust z-score (beyond 3.5); * a trend beyond 3 sigma.</p>"))
+        sections.append(Section("Histograms", image(histograms_png(stats), "histogram of each figure with its limits")))
+        sections.append(Section("Control charts", image(control_charts_png(stats), "individuals control charts")))
+        outl = [[s, fs.figure, fs.sensor] for fs in stats.figures for s in fs.outliers]
+        if outl:
+            sections.append(Section("Outliers", table(["serial", "figure", "sensor"], outl, 3)))
+    return html_report(f"Lot report: {source}", sections, {"table": source, "units": stats.count})

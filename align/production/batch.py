@@ -1,0 +1,285 @@
+"""A batch: every unit of a manifest through its single-unit job, in parallel, resumable.
+
+The batch itself runs no job: it hands each unit's :class:`Task` (the single command's words,
+its result file, its input files) to a ``worker`` (the command line's, which runs the single
+command in its process and reads its result back) through a pool (:mod:`align.production.pools`),
+and appends the rows the worker returns to the lot's table through a journal
+(:class:`align.production.table.Journal`): per unit as it finishes, so that a killed batch keeps
+what was done.
+
+Resuming: a unit is skipped when its result file exists and the table's latest row for it (serial
+and job) succeeded with the same content hash of its inputs (:func:`align.production.manifest.input_hash`:
+job, options, the bytes of its log, plan and input files). Any other unit runs again; its old result
+file is removed first, so that a unit that fails now leaves no result of other inputs behind.
+
+Public names
+------------
+Task, BatchRun, plan_tasks, run_units, unit_rows, error_rows, locked, TABLE, UNITS
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+import time
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from align.errors import AlignError, InputError
+from align.production.figures import result_rows
+from align.production.manifest import Unit, input_hash
+from align.production.table import Journal, latest_rows, now, read_table
+
+#: the table's file name in the output folder
+TABLE = "results.parquet"
+#: the folder of the units' result files in the output folder
+UNITS = "units"
+#: what a :class:`BatchRun` keeps of each row
+KEPT = ("serial", "order", "slot", "job", "sensor", "status", "exit_code", "verdict", "message")
+
+
+@dataclass(frozen=True)
+class Task:
+    """What a worker gets for one unit (picklable).
+
+    Attributes
+    ----------
+    unit : Unit
+    args : tuple of str
+        The single command's words, e.g. ``("matrix", LOG, <plan option>, PLAN, ..., <json option>, RESULT)``.
+    result : Path
+        The unit's result file, ``OUT/units/SERIAL.json``.
+    inputs : tuple of Path or None
+        The files the content hash covers (log, plan, input files the options name).
+    run : str
+        The batch run's id (its start, UTC).
+    """
+
+    unit: Unit
+    args: tuple[str, ...]
+    result: Path
+    inputs: tuple[Path | None, ...]
+    run: str
+
+    def digest(self) -> str:
+        """The content hash of the unit's inputs now."""
+        return input_hash(self.unit.job, self.unit.options, self.inputs)
+
+
+@dataclass
+class BatchRun:
+    """What a batch did: the rows of the units it ran, and those of the units it skipped.
+
+    Rows are kept without their figures (:data:`KEPT`; the table has them all): the batch's memory stays flat
+    however long the lot.
+
+    Attributes
+    ----------
+    rows : list of dict
+        One per unit and sensor run now (failed units: one row), in the order they finished.
+    skipped : list of dict
+        The table's latest rows of the units skipped (their result was there with the same inputs).
+    total : int
+        Units in the manifest.
+    """
+
+    rows: list = field(default_factory=list)
+    skipped: list = field(default_factory=list)
+    total: int = 0
+
+    def add(self, rows: list[dict], skipped: bool = False) -> None:
+        """Keep ``rows`` (of units run now, or with ``skipped`` of units skipped) without their figures."""
+        (self.skipped if skipped else self.rows).extend({k: r.get(k) for k in KEPT} for r in rows)
+
+    @staticmethod
+    def _first(rows: list, status: str | None, verdict: str | None) -> list[dict]:
+        seen, out = set(), []
+        for r in rows:
+            if r["serial"] in seen:
+                continue
+            seen.add(r["serial"])
+            if (status is None or r["status"] == status) and (verdict is None or r["verdict"] == verdict):
+                out.append(r)
+        return out
+
+    def units(self, status: str | None = None, verdict: str | None = None) -> list[dict]:
+        """One row per unit run now (its first), optionally only those of a ``status`` or ``verdict``."""
+        return self._first(self.rows, status, verdict)
+
+    def lot(self, status: str | None = None, verdict: str | None = None) -> list[dict]:
+        """As :meth:`units`, over the units run now and those skipped: the state of the whole lot."""
+        return self._first(self.rows + self.skipped, status, verdict)
+
+
+def _base(task: Task) -> dict:
+    u = task.unit
+    return {"serial": u.serial, "slot": u.slot, "order": u.order, "run": task.run, "job": u.job,
+            "result": str(task.result), "worker": socket.gethostname() + f":{os.getpid()}"}
+
+
+def error_rows(task: Task, status: str, exit_code: int, message: str, digest: str | None = None,
+               seconds: float = float("nan")) -> list[dict]:
+    """The one row of a unit that gave no result: ``status`` ``"failed"`` (the job refused its inputs or its
+    test) or ``"error"`` (an internal error, a worker that died), with the job's one-line message."""
+    return [{**_base(task), "time": now(), "sensor": None, "status": status, "exit_code": exit_code,
+             "message": message, "verdict": status, "checks": "", "input_hash": digest, "seconds": seconds,
+             "bias_unit": None}]
+
+
+def unit_rows(task: Task, exit_code: int, message: str, digest: str, seconds: float) -> list[dict]:
+    """The rows of a unit whose job ran: its figures read back from its result file when it succeeded
+    (exit status 0), else one row ``"failed"`` (status 2, 3, 4: the job refused it) or ``"error"`` (any other)."""
+    if exit_code != 0:
+        return error_rows(task, "failed" if exit_code in (2, 3, 4) else "error", exit_code, message, digest, seconds)
+    from align.results import load_result
+
+    try:
+        found = result_rows(load_result(task.result))
+    except AlignError as exc:
+        return error_rows(task, "error", 1, f"the result cannot be read back: {exc}", digest, seconds)
+    stamp = now()
+    return [{**_base(task), "time": stamp, "status": "ok", "exit_code": 0, "message": message, "input_hash": digest,
+             "seconds": seconds, **r} for r in (found or [{"sensor": None, "verdict": "pass", "checks": ""}])]
+
+
+def plan_tasks(units: Iterable[Unit], out: Path, make: Callable[[Unit, Path, str], Task],
+               run: str) -> tuple[list[Task], list[dict]]:
+    """The tasks to run, and the table's latest rows of the units to skip (see the module docstring), the
+    journal of a killed run folded first.
+
+    Parameters
+    ----------
+    units : iterable of Unit
+    out : Path
+        The output folder (holding ``units/`` and the table).
+    make : callable
+        ``make(unit, result_path, run) -> Task``: the single command's words for the unit.
+    run : str
+        This run's id.
+    """
+    table_path = out / TABLE
+    Journal(table_path).recover()
+    last: dict[tuple[str, str], list[dict]] = {}
+    for r in latest_rows(read_table(table_path)):
+        last.setdefault((r["serial"], r["job"]), []).append(r)
+    todo, skipped = [], []
+    for unit in units:
+        task = make(unit, out / UNITS / f"{unit.serial}.json", run)
+        prev = last.get((unit.serial, unit.job))
+        if (prev is not None and prev[0]["status"] == "ok" and task.result.exists()
+                and prev[0]["input_hash"] == task.digest()):
+            skipped += [{**r, "order": unit.order, "slot": unit.slot} for r in prev]
+            continue
+        todo.append(task)
+    return todo, skipped
+
+
+def run_units(tasks: list[Task], worker: Callable[[Task], list[dict]], pool, out: Path,
+              judge: Callable[[list[dict]], list[dict]] | None = None, progress=None, run: BatchRun | None = None,
+              window: int | None = None) -> BatchRun:
+    """Run ``tasks`` through ``worker`` on ``pool`` (entered), journaling each unit's rows as it finishes.
+
+    Parameters
+    ----------
+    tasks : list of Task
+    worker : callable
+        ``worker(task) -> rows`` (picklable: a module-level function).
+    pool : ProcessPool or DaskPool
+        Entered (``with pool:``).
+    out : Path
+        The output folder; its ``units/`` folder is created.
+    judge : callable, optional
+        ``judge(rows) -> rows``: the rows with their verdict against a spec.
+    progress : callable, optional
+        ``progress(done)`` after each unit.
+    run : BatchRun, optional
+        Filled in and returned (so that a caller keeps what was done when interrupted).
+    window : int, optional
+        Units in flight at once (default: twice the workers, at least 4): memory stays flat however long the lot.
+
+    Returns
+    -------
+    BatchRun
+        The rows of this run (the table holds them too once the journal is folded, at the end of this
+        call, even when interrupted).
+    """
+    run = run if run is not None else BatchRun()
+    (out / UNITS).mkdir(parents=True, exist_ok=True)
+    journal = Journal(out / TABLE)
+    window = window or max(4, 2 * int(getattr(pool, "workers", None) or 2))
+    pending = list(reversed(tasks))
+    flight: dict = {}
+    done = 0
+    try:
+        for t in tasks:
+            if t.result.exists():
+                t.result.unlink()  # a result of other inputs, or of a run killed before its row
+        for left in (out / UNITS).glob(".*.json.*"):  # temporaries of a run killed while writing (the lock is ours)
+            left.unlink(missing_ok=True)
+        while pending or flight:
+            while pending and len(flight) < window:
+                task = pending.pop()
+                flight[pool.submit(worker, task)] = (task, time.perf_counter())
+            for fut in pool.wait(flight):
+                task, started = flight.pop(fut)
+                rows = _collect(fut, task, started, pool)
+                rows = judge(rows) if judge is not None else rows
+                journal.add(rows)
+                run.add(rows)
+                done += 1
+                if progress is not None:
+                    progress(done)
+    finally:
+        journal.fold()
+    return run
+
+
+def _collect(fut, task: Task, started: float, pool) -> list[dict]:
+    """The rows a finished future holds; a worker that raised or died gives the unit one ``"error"`` row."""
+    from align.production.pools import BrokenPool
+
+    try:
+        return fut.result()
+    except BrokenPool as exc:
+        pool.restart()
+        what = f"the worker process died ({type(exc).__name__}); run the unit alone to see why"
+    except Exception as exc:  # the worker's own failure (not the job's: the job's errors are its exit status)
+        what = f"the worker failed ({' '.join(f'{type(exc).__name__}: {exc}'.split())[:240]})"
+    return error_rows(task, "error", 1, f"imu-align: internal error: {what}", None, time.perf_counter() - started)
+
+
+@contextmanager
+def locked(out: Path) -> Iterator[None]:
+    """Hold the output folder for one batch at a time (``OUT/.batch.lock``, naming the host and process);
+    a lock whose process is gone (a killed batch on this host) is taken over."""
+    path = out / ".batch.lock"
+    me = f"{socket.gethostname()} {os.getpid()}"
+    for _ in range(2):
+        try:
+            fd = os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+        except FileExistsError:
+            host, _, pid = (path.read_text(errors="replace").strip() or " ").partition(" ")
+            if not host or (host == socket.gethostname() and not _alive(pid)):  # empty: killed while writing it
+                path.unlink(missing_ok=True)
+                continue
+            raise InputError(f"another batch ({host}, process {pid}) is writing to {out}; wait for it, or give "
+                             f"another {{out}} (remove {path} if no batch runs)", "{out}") from None
+        with os.fdopen(fd, "w") as fh:
+            fh.write(me)
+        break
+    try:
+        yield
+    finally:
+        path.unlink(missing_ok=True)
+
+
+def _alive(pid: str) -> bool:
+    try:
+        os.kill(int(pid), 0)
+    except (ValueError, ProcessLookupError):
+        return False
+    except PermissionError:  # a process of another user
+        return True
+    return True

@@ -1,0 +1,251 @@
+"""The manifest of a lot: which units to run, with which job, inputs and options.
+
+A manifest is a CSV file (one row per unit) or a TOML file (``[[unit]]`` tables, with an
+optional ``[defaults]`` table whose keys every unit takes unless it states its own)::
+
+    serial,job,log,plan,options,slot
+    SN0001,matrix,sessions/SN0001.csv,plan.toml,--gyro-units deg/s,1
+    SN0002,calibrate accel,sessions/SN0002.csv,,,2
+
+Columns: ``serial`` (names the unit's result file: letters, digits, ``.``, ``_``, ``-``), ``job``
+(a command of the single-unit tool), ``log``, ``plan`` (empty where the job has none), ``options``
+(the single command's options as typed, split as a POSIX shell splits them; ``{serial}`` in them
+becomes the unit's serial), and optionally ``slot`` (the fixture slot). Paths are relative to the
+manifest's folder. A bad manifest is one :class:`~align.errors.InputError` naming the file, the
+row (CSV line or ``[[unit]]`` number) and the column.
+
+The content hash of a unit's inputs (:func:`input_hash`) decides whether a rerun may skip it.
+
+Public names
+------------
+Unit, Manifest, read_manifest, input_hash, PLAN_USE, SERIAL
+"""
+
+from __future__ import annotations
+
+import csv
+import difflib
+import hashlib
+import io
+import re
+import shlex
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+from align.errors import InputError, literal
+from align.io.files import read_text, read_toml
+
+#: what a job does with the manifest's ``plan`` column: needs one, may take one, takes none
+PLAN_USE = ("required", "optional", "none")
+#: a serial number names a file: letters, digits, '.', '_' and '-', not starting with '.'
+SERIAL = re.compile(r"^[A-Za-z0-9_-][A-Za-z0-9._-]{0,127}$")
+#: the columns of a manifest: required ones, then optional ones
+REQUIRED = ("serial", "job", "log")
+OPTIONAL = ("plan", "options", "slot")
+
+
+@dataclass(frozen=True)
+class Unit:
+    """One unit of a lot, as its manifest row states it (paths resolved against the manifest's folder).
+
+    Attributes
+    ----------
+    serial : str
+        The unit's serial number (its result file is ``SERIAL.json``).
+    job : str
+        The single-unit command, e.g. ``"matrix"`` or ``"calibrate accel"``.
+    log : Path
+        The unit's log, absolute.
+    plan : Path or None
+        The job's plan-like input (test plan, positions, sections), absolute; None when not given.
+    options : tuple of str
+        The single command's options, split as typed (``{serial}`` replaced).
+    slot : str or None
+        The fixture slot.
+    order : int
+        Position in the manifest, from 0 (the lot's order for trends).
+    row : str
+        Where the unit is stated, for messages: ``"line 4"`` (CSV) or ``"[[unit]] 3"`` (TOML).
+    """
+
+    serial: str
+    job: str
+    log: Path
+    plan: Path | None
+    options: tuple[str, ...]
+    slot: str | None
+    order: int
+    row: str
+
+
+@dataclass(frozen=True)
+class Manifest:
+    """A manifest file and its units, in order."""
+
+    path: Path
+    units: tuple[Unit, ...]
+
+    @property
+    def folder(self) -> Path:
+        """The folder the manifest's paths are relative to."""
+        return self.path.parent
+
+
+def read_manifest(path: str | Path, jobs: Mapping[str, str]) -> Manifest:
+    """Read a manifest (CSV, or TOML by its ``.toml`` suffix) and check every row.
+
+    Parameters
+    ----------
+    path : str or Path
+    jobs : mapping of str -> str
+        The jobs a unit may name, each with its use of the ``plan`` column (one of :data:`PLAN_USE`).
+
+    Returns
+    -------
+    Manifest
+
+    Raises
+    ------
+    InputError
+        A missing or unknown column, an unknown job, a serial that cannot name a file or is given twice,
+        an empty log, a plan missing where the job needs one (or given where it takes none), options that
+        cannot be split: naming the file, the row and the column.
+    """
+    p = Path(path)
+    records = _toml_records(p) if p.suffix.lower() == ".toml" else _csv_records(p)
+    if not records:
+        raise InputError("lists no units; give one row per unit", str(p))
+    folder = p.resolve().parent
+    units, seen = [], {}
+    for order, (row, record) in enumerate(records):
+        unit = _unit(record, row, order, folder, jobs, str(p))
+        if unit.serial in seen:
+            raise InputError(f"{row}, column serial: {unit.serial} is also the serial of {seen[unit.serial]}; "
+                             "give each unit its own", str(p))
+        seen[unit.serial] = row
+        units.append(unit)
+    return Manifest(p, tuple(units))
+
+
+def _csv_records(path: Path) -> list[tuple[str, dict]]:
+    text = read_text(path).lstrip("\ufeff")
+    reader = csv.reader(io.StringIO(text))
+    header, records = None, []
+    for fields in reader:
+        if not any(f.strip() for f in fields) or fields[0].lstrip().startswith("#"):
+            continue  # blank lines and comments
+        if header is None:
+            header = [f.strip().lower() for f in fields]
+            _check_columns(header, f"line {reader.line_num}", str(path))
+            continue
+        row = f"line {reader.line_num}"
+        if len(fields) > len(header):
+            raise InputError(f"{row}: {len(fields)} fields but the header names {len(header)} columns; quote a "
+                             "field that holds a comma", str(path))
+        records.append((row, {k: v.strip() for k, v in zip(header, fields)}))
+    if header is None:
+        raise InputError(f"is empty; give a header ({','.join(REQUIRED + OPTIONAL)}) and one row per unit", str(path))
+    return records
+
+
+def _check_columns(header: list[str], row: str, where: str) -> None:
+    known = REQUIRED + OPTIONAL
+    for name in header:
+        if name not in known:
+            close = difflib.get_close_matches(name, known, n=1)
+            hint = f" (did you mean {close[0]}?)" if close else ""
+            raise InputError(f"{row}: unknown column '{literal(name)}'{hint}; the columns are {', '.join(known)}", where)
+    for name in REQUIRED:
+        if name not in header:
+            raise InputError(f"{row}: the header has no column {name}; the columns are {', '.join(known)}", where)
+    doubled = {n for n in header if header.count(n) > 1}
+    if doubled:
+        raise InputError(f"{row}: column {sorted(doubled)[0]} is named twice", where)
+
+
+def _toml_records(path: Path) -> list[tuple[str, dict]]:
+    data = read_toml(path)
+    unknown = [k for k in data if k not in ("defaults", "unit")]
+    if unknown:
+        raise InputError(f"unknown table or key '{literal(unknown[0])}'; a manifest holds [defaults] and [[unit]] tables",
+                         str(path))
+    defaults = data.get("defaults", {})
+    units = data.get("unit", [])
+    if not isinstance(defaults, dict) or not isinstance(units, list) or not all(isinstance(u, dict) for u in units):
+        raise InputError("give [defaults] as a table and each unit as a [[unit]] table", str(path))
+    records = []
+    for k, unit in enumerate(units, 1):
+        row = f"[[unit]] {k}"
+        merged = {**defaults, **unit}
+        for key, value in merged.items():
+            if key not in REQUIRED + OPTIONAL:
+                raise InputError(f"{row}: unknown key '{literal(key)}'; the keys are {', '.join(REQUIRED + OPTIONAL)}",
+                                 str(path))
+            if key == "options" and isinstance(value, list) and all(isinstance(v, str) for v in value):
+                merged[key] = shlex.join(value)
+            elif isinstance(value, (int, float)) and not isinstance(value, bool) and key in ("serial", "slot"):
+                merged[key] = str(value)
+            elif not isinstance(value, str):
+                raise InputError(f"{row}, column {key}: give a string (got {literal(repr(value))})", str(path))
+        records.append((row, {k: v.strip() for k, v in merged.items()}))
+    return records
+
+
+def _unit(record: dict, row: str, order: int, folder: Path, jobs: Mapping[str, str], where: str) -> Unit:
+    def bad(column: str, what: str) -> InputError:
+        return InputError(f"{row}, column {column}: {what}", where)
+
+    serial = record.get("serial", "")
+    if not SERIAL.match(serial):
+        raise bad("serial", f"'{literal(serial)}' cannot name a file; use letters, digits, '.', '_' and '-'"
+                  if serial else "empty; give the unit's serial number")
+    job = " ".join(record.get("job", "").split())
+    if job not in jobs:
+        close = difflib.get_close_matches(job, list(jobs), n=1)
+        hint = f" (did you mean {close[0]}?)" if close else ""
+        raise bad("job", f"unknown job '{literal(job)}'{hint}; the jobs are {', '.join(jobs)}" if job
+                  else f"empty; give one of {', '.join(jobs)}")
+    log = record.get("log", "")
+    if not log:
+        raise bad("log", "empty; give the unit's log file")
+    plan, use = record.get("plan", ""), jobs[job]
+    if use == "required" and not plan:
+        raise bad("plan", f"empty; the {job} job needs one")
+    if use == "none" and plan:
+        raise bad("plan", f"the {job} job takes no plan; leave it empty")
+    try:
+        options = tuple(t.replace("{serial}", serial) for t in shlex.split(record.get("options", ""), comments=False))
+    except ValueError as exc:
+        raise bad("options", f"cannot be split ({exc}); check the quotes") from None
+    slot = record.get("slot") or None
+    return Unit(serial, job, (folder / log).resolve(), (folder / plan).resolve() if plan else None, options, slot,
+                order, row)
+
+
+def input_hash(job: str, options: Iterable[str], files: Iterable[Path | None]) -> str:
+    """The content hash (SHA-256, hex) of a unit's inputs: its job, its options as typed, and the bytes of
+    each input file in order (a missing file hashes as missing, so that it counts as changed once it exists).
+
+    Two units hash alike exactly when their job, options and input contents are the same; the files'
+    names and times do not enter.
+    """
+    h = hashlib.sha256(b"imu-align batch inputs 1\0")
+    h.update(hashlib.sha256("\0".join([job, *options]).encode()).digest())
+    for path in files:
+        h.update(_file_digest(path))
+    return h.hexdigest()
+
+
+def _file_digest(path: Path | None) -> bytes:
+    """SHA-256 of a file's bytes; fixed tags for no file and a missing (unreadable) one."""
+    if path is None:
+        return b"none"
+    inner = hashlib.sha256()
+    try:
+        with open(path, "rb") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                inner.update(block)
+    except OSError:
+        return b"missing"
+    return inner.digest()

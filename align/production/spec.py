@@ -1,0 +1,194 @@
+"""A lot's spec: limits per figure, read from TOML with their units (parsed here, at the edge).
+
+::
+
+    phi_xy = { abs_max = "0.1 deg" }            # |phi_xy| <= 0.1 deg
+    "phi_*" = { abs_max = "0.1 deg" }           # every cross-axis angle (shell-style pattern)
+    scale_x = { min = 0.995, max = 1.005 }      # plain numbers for ratios ("0.5 %" works too)
+    arw_x = { max = "0.3 deg/sqrt(h)" }         # an angular unit: applies to gyroscopes
+    bias_x = { abs_max = "0.05 m/s^2" }         # an acceleration: applies to accelerometers
+
+    [magnetometer]                              # limits for one sensor only
+    heading_error = { max = "1 deg" }
+
+A limit of a figure whose unit depends on the sensor (bias, noise terms) applies to the sensors
+whose figure has the limit's dimension; one of another dimension is refused. A figure is shown
+in the unit its limit is written in.
+
+Public names
+------------
+Limit, Spec, read_spec, SENSORS
+"""
+
+from __future__ import annotations
+
+import fnmatch
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from align.errors import InputError, literal
+from align.io.files import read_toml
+from align.production.figures import FIGURES, KIND, shown_unit, si_unit
+from align.units import parse_unit, to_unit
+
+#: the sensors a row may be of, and a spec table may be named after
+SENSORS = ("gyroscope", "accelerometer", "magnetometer")
+_BOUNDS = ("min", "max", "abs_max")
+_NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*)$")
+
+
+@dataclass(frozen=True)
+class Limit:
+    """One figure's limits for one sensor (``""``: a figure whose unit is the same for every sensor).
+
+    Attributes
+    ----------
+    figure : str
+    sensor : str
+    low, high : float or None
+        SI; None where open.
+    unit : str
+        The unit the spec wrote it in (the figure is shown in it).
+    symmetric : bool
+        Written as ``abs_max`` (``|x| <= high``).
+    """
+
+    figure: str
+    sensor: str
+    low: float | None
+    high: float | None
+    unit: str
+    symmetric: bool = False
+
+    def applies(self, sensor: str | None) -> bool:
+        """True for a row of ``sensor``."""
+        return self.sensor == "" or self.sensor == sensor
+
+    def ok(self, value: float) -> bool:
+        """True when ``value`` (SI, finite) lies within the limits (bounds included)."""
+        return (self.low is None or value >= self.low) and (self.high is None or value <= self.high)
+
+    def shown(self, value: float) -> float:
+        """``value`` (SI) in the limit's unit."""
+        return float(to_unit(value, self.unit)) if self.unit != "1" else float(value)
+
+    def describe(self) -> str:
+        """``|phi_xy| <= 0.1 deg``, ``0.995 <= scale_x <= 1.005``, ``arw_x <= 0.3 deg/sqrt(h)``."""
+        u = "" if self.unit == "1" else f" {self.unit}"
+        if self.symmetric:
+            return f"|{self.figure}| <= {self.shown(self.high):g}{u}"
+        if self.low is not None and self.high is not None:
+            return f"{self.shown(self.low):g} <= {self.figure} <= {self.shown(self.high):g}{u}"
+        if self.high is not None:
+            return f"{self.figure} <= {self.shown(self.high):g}{u}"
+        return f"{self.figure} >= {self.shown(self.low):g}{u}"
+
+
+@dataclass(frozen=True)
+class Spec:
+    """The limits of a spec file, in the file's order."""
+
+    path: str
+    limits: tuple[Limit, ...]
+
+    def limits_for(self, figure: str, sensor: str | None) -> list[Limit]:
+        """The limits that apply to ``figure`` in a row of ``sensor``."""
+        return [lim for lim in self.limits if lim.figure == figure and lim.applies(sensor)]
+
+
+def read_spec(path: str | Path) -> Spec:
+    """Read a spec TOML (module docstring).
+
+    Raises
+    ------
+    InputError
+        An unknown figure, key or sensor table; a bound that is not a quantity or of the wrong dimension;
+        ``min`` above ``max``; naming the file and the key.
+    """
+    where = str(path)
+    data = read_toml(path)
+    limits: list[Limit] = []
+    for key, value in data.items():
+        if key in SENSORS:
+            if not isinstance(value, dict):
+                raise InputError(f"{key}: give a table of limits ([{key}])", where)
+            for k, v in value.items():
+                limits += _limits(k, v, key, f"{key}.{k}", where)
+        else:
+            limits += _limits(key, value, None, key, where)
+    if not limits:
+        raise InputError("states no limit; give e.g. phi_xy = { abs_max = \"0.1 deg\" }", where)
+    return Spec(where, tuple(limits))
+
+
+def _figures(pattern: str, key: str, where: str) -> list[str]:
+    found = [f for f in FIGURES if fnmatch.fnmatchcase(f, pattern)]
+    if not found:
+        import difflib
+
+        close = difflib.get_close_matches(pattern, FIGURES, n=1)
+        hint = f" (did you mean {close[0]}?)" if close else ""
+        raise InputError(f"{literal(key)}: no figure is named so{hint}; the figures are scale_x, phi_xy, delta_xy, "
+                         "rotation_x, bias_x, arw_x, bi_x, rrw_x, M_xy, field, coverage, heading_error, spread "
+                         "(x, y, z each)", where)
+    return found
+
+
+def _bound(text, figure: str, key: str, name: str, where: str) -> tuple[float, str, tuple]:
+    """(number, unit text, dimension) of one bound as written."""
+    if isinstance(text, bool) or not isinstance(text, (int, float, str)):
+        raise InputError(f"{literal(key)}.{name}: give a number or a quantity such as '0.1 deg'", where)
+    if isinstance(text, str):
+        m = _NUMBER.match(text)
+        if not m:
+            raise InputError(f"{literal(key)}.{name}: '{literal(text)}' does not start with a number", where)
+        number, unit = float(m.group(1)), m.group(2).strip() or "1"
+    else:
+        number, unit = float(text), "1"
+    if not math.isfinite(number):
+        raise InputError(f"{literal(key)}.{name}: not a finite number", where)
+    u = parse_unit(unit, None, f"{where}: {key}.{name}")
+    return number * u.factor, unit, u.dim
+
+
+def _limits(pattern: str, value, sensor: str | None, key: str, where: str) -> list[Limit]:
+    if not isinstance(value, dict) or not value:
+        raise InputError(f"{literal(key)}: give its limits as a table, e.g. {{ min = ..., max = ... }} or "
+                         "{ abs_max = ... }", where)
+    for name in value:
+        if name not in _BOUNDS:
+            raise InputError(f"{literal(key)}: unknown bound '{literal(name)}'; use min, max or abs_max", where)
+    if "abs_max" in value and ("min" in value or "max" in value):
+        raise InputError(f"{literal(key)}: give abs_max, or min and/or max, not both", where)
+    out = []
+    for figure in _figures(pattern, key, where):
+        bounds = {n: _bound(v, figure, key, n, where) for n, v in value.items()}
+        dims = {b[2] for b in bounds.values()}
+        if len(dims) > 1:
+            raise InputError(f"{literal(key)}: its bounds are of different dimensions; write them in one unit", where)
+        dim = dims.pop()
+        unit = next(iter(bounds.values()))[1]
+        if sensor:
+            sensors = [sensor]
+        else:
+            sensors = [""] if KIND[figure] in ("1", "angle") else list(SENSORS)
+        matching = [s for s in sensors if (si := si_unit(figure, s)) and parse_unit(si).dim == dim]
+        if not matching:
+            wanted = sorted({f"'{shown_unit(figure, s)}'" for s in sensors if si_unit(figure, s)})
+            raise InputError(f"{literal(key)}: '{literal(unit)}' is not a unit of {figure}"
+                             + (f" for the {sensor}" if sensor else "")
+                             + (f"; write it like {' or '.join(wanted)}" if wanted else ""), where)
+        if "abs_max" in bounds:
+            high = bounds["abs_max"][0]
+            if high < 0:
+                raise InputError(f"{literal(key)}.abs_max: must be >= 0", where)
+            low, symmetric = -high, True
+        else:
+            low, high = (bounds["min"][0] if "min" in bounds else None), (bounds["max"][0] if "max" in bounds else None)
+            symmetric = False
+            if low is not None and high is not None and low > high:
+                raise InputError(f"{literal(key)}: min is above max", where)
+        out += [Limit(figure, s, low, high, unit, symmetric) for s in matching]
+    return out

@@ -1,0 +1,55 @@
+"""The batch runner with stand-in workers: a worker that dies, and Ctrl-C in the middle of a lot."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pyarrow.parquet as pq
+import pytest
+
+from align.production import BatchRun, Task, Unit, run_units, unit_rows
+from align.production.pools import ProcessPool
+
+
+def _tasks(folder: Path, n: int) -> list[Task]:
+    units = [Unit(f"U{k}", "allan", folder / f"U{k}.csv", None, (), None, k, f"line {k + 2}") for k in range(n)]
+    return [Task(u, ("allan", str(u.log)), folder / "units" / f"{u.serial}.json", (u.log,), "run1") for u in units]
+
+
+def dying_worker(task: Task) -> list[dict]:
+    """Kills its own process for unit U2 (a crash no Python handler sees); a failed job for the others."""
+    if task.unit.serial == "U2":
+        os._exit(7)
+    return unit_rows(task, 3, f"imu-align: error: {task.unit.log.name}: too short", task.digest(), 0.01)
+
+
+def test_a_worker_that_dies_costs_its_unit_only(tmp_path):
+    tasks = _tasks(tmp_path, 6)
+    with ProcessPool(1) as pool:
+        run = run_units(tasks, dying_worker, pool, tmp_path, window=1)
+    rows = {r["serial"]: r for r in run.rows}
+    assert sorted(rows) == [f"U{k}" for k in range(6)]
+    assert rows["U2"]["status"] == "error" and "the worker process died" in rows["U2"]["message"]
+    assert all(rows[s]["status"] == "failed" and rows[s]["exit_code"] == 3 for s in rows if s != "U2")
+    assert len(pq.read_table(tmp_path / "results.parquet")) == 6
+
+
+def test_ctrl_c_in_the_middle_keeps_the_units_done(tmp_path):
+    tasks = _tasks(tmp_path, 10)
+    run = BatchRun(total=10)
+
+    def progress(done):
+        if done == 4:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        with ProcessPool(2) as pool:
+            run_units(tasks, failing_worker, pool, tmp_path, progress=progress, run=run, window=2)
+    table = pq.read_table(tmp_path / "results.parquet").to_pandas()  # the journal was folded on the way out
+    assert len(run.units()) == 4 and sorted(table.serial) == sorted(r["serial"] for r in run.rows)
+    assert not (tmp_path / "results.parquet.journal").exists()
+
+
+def failing_worker(task: Task) -> list[dict]:
+    return unit_rows(task, 2, "imu-align: error: x: file not found", task.digest(), 0.01)
