@@ -18,36 +18,12 @@ from __future__ import annotations
 
 import argparse
 import json
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
-#: as bench/_measure.py's launcher, also reporting the command's CPU time (user + system: what a loaded machine
-#: cannot inflate the way it inflates wall time)
-_LAUNCHER = (
-    "import resource, subprocess, sys, time\n"
-    "t0 = time.perf_counter()\n"
-    "p = subprocess.run(sys.argv[1:], capture_output=True, text=True)\n"
-    "wall = time.perf_counter() - t0\n"
-    "sys.stderr.write(p.stderr)\n"
-    "u = resource.getrusage(resource.RUSAGE_CHILDREN)\n"
-    "print(p.returncode, wall, u.ru_maxrss, u.ru_utime + u.ru_stime)\n"
-)
-
-
-def measure(cmd: list[str], repeat: int = 1) -> tuple[float, float, float]:
-    """Best wall time (s), its CPU time (s) and the peak RSS (MB) of ``cmd`` alone, over ``repeat`` runs."""
-    best, cpu, peak = float("inf"), 0.0, 0.0
-    for _ in range(repeat):
-        out = subprocess.run([sys.executable, "-c", _LAUNCHER, *cmd], capture_output=True, text=True)
-        code, wall, rss_kb, used = out.stdout.split()
-        if code != "0":
-            raise SystemExit(f"failed: {' '.join(cmd)}\n{out.stderr}")
-        if float(wall) < best:
-            best, cpu = float(wall), float(used)
-        peak = max(peak, float(rss_kb) / 1024.0)
-    return best, cpu, peak
+sys.path.insert(0, str(Path(__file__).parent))
+from _measure import measure_cpu as measure  # noqa: E402
 
 ANCHOR = r"""
 import json, sys

@@ -104,7 +104,7 @@ class AlignmentResult(Result, format=FORMAT, version=FORMAT_VERSION, convention=
 
     def as_c_header(self, comment: str, name: str = "IMU_ALIGN") -> str:
         """A C header with ``A`` and the bias (in :attr:`units`) for ``w = A (g - b)`` in firmware."""
-        return c_header(name, self.A, to_unit(self.bias, self.units), self.units, f"{comment}\n{CONVENTION}")
+        return c_header(name, self.A, to_unit(self.bias, self.units), self.units, comment)
 
     def to_dict(self) -> dict:
         """The versioned JSON form; rates in ``self.units``, angles in deg."""

@@ -21,14 +21,16 @@ scaling. Gates refuse, with a clear message, data that cannot give a trustworthy
 too few samples, planar or clustered captures (the hard iron's 1-sigma from the
 refinement exceeds 2 % of the field), a quadric that is not an ellipsoid, a
 reflected solution. With simultaneous accelerometer data,
-:func:`with_gravity_alignment` adds the rotation to the accelerometer frame;
+:func:`with_gravity_alignment` (:mod:`align.calibration.gravityalign`, re-exported here) adds the rotation to
+the accelerometer frame;
 :func:`align.calibration.axisdown.with_axis_down` the rotation to the body axes
 from axis-down turns (seed 004).
 :class:`MagCalibration` is the registered result ``imu-align.magnetometer``.
 
 Public names
 ------------
-MagCalibration, calibrate_magnetometer, with_gravity_alignment, alignment_to_gravity, misalignment_from_axes_down,
+MagCalibration, calibrate_magnetometer, with_gravity_alignment, alignment_to_gravity (both re-exported from
+:mod:`align.calibration.gravityalign`), misalignment_from_axes_down,
 MODELS, FORMAT, CONVENTION, ANGLES_ARE, COVARIANCE_IS
 """
 
@@ -39,6 +41,7 @@ from dataclasses import field as dataclass_field
 import numpy as np
 
 from align.calibration.ellipsoid import MODELS, algebraic_fit, full_params, refine, unpack
+from align.calibration.gravityalign import alignment_to_gravity, dip_from_accelerometer, with_gravity_alignment
 from align.errors import InputError, TestError, literal
 from align.io import check_finite
 from align.plausible import check_dip, check_field_strength, check_known_field, check_positive_definite
@@ -141,6 +144,17 @@ class MagCalibration(Result, format=FORMAT, convention=CONVENTION, version=2):
 
         u, _, vt = np.linalg.svd(self.misalignment)  # the nearest rotation (the matrix is one up to rounding)
         return Rotation.from_matrix(u @ vt).as_rotvec()
+
+    @property
+    def correcting(self) -> np.ndarray:
+        """The whole correcting matrix, dimensionless, shape (3, 3): ``misalignment soft_iron`` (``soft_iron``
+        without a misalignment), so that ``m = correcting (m_raw - hard_iron)`` in the body frame."""
+        return self.soft_iron if self.misalignment is None else self.misalignment @ self.soft_iron
+
+    @property
+    def model_matrix(self) -> np.ndarray:
+        """``M = correcting^-1`` of the model ``m_raw = M m + hard_iron`` (rows: the magnetometer axes), shape (3, 3)."""
+        return np.linalg.inv(self.correcting)
 
     def correction(self, sensor: str | None = None, where: str = "magnetometer") -> MagCalibration:
         """This calibration, which corrects magnetometer logs (see :class:`align.results.Correction`).
@@ -334,10 +348,8 @@ def calibrate_magnetometer(m: np.ndarray, units: str = "uT", field: float | None
     notes = [f"{model} model, {len(m)} samples; " + ("field fixed at the value given" if field is not None else
                                                       "field fitted (soft iron scaled to unit determinant)"), notes_refine]
     if acc is not None:
-        a = np.asarray(acc, float)
-        cosang = np.sum(u * a, axis=1) / np.linalg.norm(a, axis=1)
-        dip = float(np.arcsin(np.clip(np.median(cosang), -1, 1)))
-        notes.append(f"dip {np.degrees(dip):.2f} deg from the accelerometer (median angle between field and gravity)")
+        dip, note = dip_from_accelerometer(u, acc)
+        notes.append(note)
     elif dip is None:
         dip = 60 * DEG
         notes.append("dip not measured: heading error predicted for 60 deg (mid latitudes); "
@@ -362,46 +374,5 @@ def misalignment_from_axes_down(down: dict) -> np.ndarray:
     return np.array([r / np.linalg.norm(r) for r in rows])
 
 
-def alignment_to_gravity(m_cal: np.ndarray, acc: np.ndarray) -> tuple[np.ndarray, float, float]:
-    """Rotation ``R`` (mag frame to accelerometer frame) making the field-gravity angle constant.
-
-    Minimises the scatter of ``asin(a_hat . R m_hat)`` (the dip) over a tumbling
-    capture; returns ``R``, the dip (rad) and the remaining scatter (rad).
-    """
-    from scipy.optimize import least_squares
-    from scipy.spatial.transform import Rotation
-
-    mh = m_cal / np.linalg.norm(m_cal, axis=1, keepdims=True)
-    ah = acc / np.linalg.norm(acc, axis=1, keepdims=True)
-
-    def resid(p):
-        r = Rotation.from_rotvec(p[:3]).as_matrix()
-        return np.arcsin(np.clip(np.sum(ah * (mh @ r.T), axis=1), -1, 1)) - p[3]
-
-    p0 = np.array([0.0, 0.0, 0.0, float(np.median(np.arcsin(np.clip(np.sum(ah * mh, axis=1), -1, 1))))])
-    sol = least_squares(resid, p0)
-    return Rotation.from_rotvec(sol.x[:3]).as_matrix(), float(sol.x[3]), float(np.std(sol.fun))
-
-
-def with_gravity_alignment(cal: MagCalibration, m: np.ndarray, acc: np.ndarray) -> MagCalibration:
-    """``cal`` with its rotation to the accelerometer frame, found from gravity (:func:`alignment_to_gravity`).
-
-    Parameters
-    ----------
-    cal : MagCalibration
-        A calibration of the capture ``m``.
-    m : ndarray, shape (n, 3)
-        The raw magnetometer readings ``cal`` was fitted to, SI or counts.
-    acc : ndarray, shape (n, 3)
-        Simultaneous accelerometer readings (any unit).
-
-    Returns
-    -------
-    MagCalibration
-        ``cal`` with ``misalignment`` set (``m_body = misalignment m_cal``) and a note
-        giving the fitted dip and the remaining scatter.
-    """
-    rot, dip_fit, scatter = alignment_to_gravity(cal.correct(m), np.asarray(acc, float))
-    note = (f"rotation to the accelerometer frame from gravity: dip {np.degrees(dip_fit):.2f} deg, "
-            f"scatter {np.degrees(scatter):.2f} deg after alignment")
-    return cal.replace(misalignment=rot, misalignment_method="gravity", notes=cal.notes + (note,))
+__all__ = ["MagCalibration", "calibrate_magnetometer", "with_gravity_alignment", "alignment_to_gravity",
+           "misalignment_from_axes_down", "MODELS", "FORMAT", "CONVENTION", "ANGLES_ARE", "COVARIANCE_IS"]

@@ -32,6 +32,39 @@ def _c_name(text: str) -> str:
     return text
 
 
+#: what a file that is not a result gets told
+NOT_A_RESULT = ("not a result file: give a JSON written by an imu-align command's --json (matrix, calibrate, allan, "
+                "calibrate mag)")
+
+
+def _load(path: Path):
+    """The result in ``path``; a file that is not one (not JSON, not UTF-8, no imu-align format) gets one line
+    saying what to give."""
+    from align.errors import InputError
+    from align.io import read_json
+    from align.results import result_from_dict
+
+    try:
+        d = read_json(path)
+    except InputError as exc:
+        if exc.message.startswith(("not valid JSON", "not UTF-8", "holds NUL", "is empty", "expected a JSON")):
+            raise InputError(NOT_A_RESULT, str(path)) from None
+        raise  # missing, a folder, unreadable: said as it is
+    if not isinstance(d.get("format"), str) or not d["format"].startswith("imu-align."):
+        raise InputError(NOT_A_RESULT, str(path))
+    return result_from_dict(d, str(path))
+
+
+def _unused(to: str, name: str | None, rostopic: str | None) -> None:
+    """``--name`` only for ``--to c``, ``--rostopic`` only for ``--to kalibr``: refused elsewhere, not ignored."""
+    from align.errors import InputError
+
+    if name is not None and to != "c":
+        raise InputError(f"names the C arrays; --to {to} has none: leave it out (or give --to c)", "{name}")
+    if rostopic is not None and to != "kalibr":
+        raise InputError(f"is Kalibr's ROS topic; --to {to} has none: leave it out (or give --to kalibr)", "{rostopic}")
+
+
 def export(
     results: Annotated[list[Path], typer.Argument(metavar="RESULT.json...", show_default=False, help=(
         "Result file(s) of imu-align (--json). kalibr takes an allan result per sensor and an alignment or "
@@ -43,15 +76,15 @@ def export(
     out: opt.OptInput("--out", "Write the export here (default: print it).", "FILE") = None,
     name: Annotated[str | None, typer.Option("--name", parser=_c_name, metavar="PREFIX", help=(
         "C header: prefix of the arrays (default IMU_ALIGN, IMU_CAL or IMU_MAG)."))] = None,
-    rostopic: Annotated[str, typer.Option("--rostopic", parser=_rostopic, metavar="TOPIC", help=(
-        "kalibr: the IMU's ROS topic."))] = "/imu0",
+    rostopic: Annotated[str | None, typer.Option("--rostopic", parser=_rostopic, metavar="TOPIC", help=(
+        "kalibr: the IMU's ROS topic (default /imu0)."))] = None,
 ) -> None:
     """A result in the format another program loads, stating its convention, frame, units and the tool version."""
-    check_outputs(results, out=out)
+    check_outputs(results, results=results, out=out)  # nor a data file a result names (its record of the inputs)
+    _unused(value(to), name, rostopic)
     from align.present.exports import export_text
-    from align.results import load_result
 
-    text = export_text([(load_result(p), str(p)) for p in results], value(to), name, rostopic)
+    text = export_text([(_load(p), str(p)) for p in results], value(to), name, rostopic or "/imu0")
     if out is None:
         typer.echo(text, nl=False)
         return

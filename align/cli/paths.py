@@ -14,7 +14,7 @@ no output at all (:func:`outputs`).
 
 Public names
 ------------
-check_outputs, output_folder, outputs
+check_outputs, output_folder, outputs, data_files, named_inputs, resolve_named
 """
 
 from __future__ import annotations
@@ -62,7 +62,7 @@ def _writable(folder: Path, where: str) -> None:
 
 
 def check_outputs(inputs: Iterable[Path | None] = (), folder: tuple[str, Path, Iterable[str]] | None = None,
-                  **outputs: Path | None) -> None:
+                  results: Iterable[Path | None] = (), **outputs: Path | None) -> None:
     """Refuse, before any work, outputs that cannot be written or would overwrite an input.
 
     Parameters
@@ -74,8 +74,20 @@ def check_outputs(inputs: Iterable[Path | None] = (), folder: tuple[str, Path, I
         created by the run's :class:`~align.io.outputs.Outputs` (and removed again if the run fails).
     **outputs : Path or None
         Output files by field name (``json_out=...``, ``c_header=...``); None: not given.
+    results : iterable of Path or None
+        Result files the command reads: the data files each names (:func:`named_inputs`) are inputs
+        too, and an output that is one is refused naming the result.
     """
     ins = [Path(p) for p in inputs if p is not None]
+    for result in results:
+        if result is None:
+            continue
+        for named in named_inputs(result):
+            for field, p in outputs.items():
+                if p is not None and _same(Path(p), named):
+                    raise InputError(f"{p} is a data file {Path(result).name} names (its record of the inputs); "
+                                     "write to another file", "{" + field + "}")
+            ins.append(named)
     seen: list[tuple[str, Path, bool]] = []
     if folder is not None:
         field, path, names = folder
@@ -125,6 +137,64 @@ def data_files(mount: Path | None = None, manoeuvre: Path | None = None) -> list
         except (OSError, ValueError):  # missing, a folder, not UTF-8, not TOML
             continue
         found += listed(data, Path(path).parent)
+    return found
+
+
+#: keys of a result's ``inputs`` that name files (other keys' strings count when such a file exists)
+_FILE_KEYS = ("log", "plan", "accel_log", "positions", "segments", "mount", "manoeuvre", "parts", "allan",
+              "alignment", "frame", "static", "logs", "capture")
+
+
+def resolve_named(result_path: Path | str, name: str | Path) -> Path:
+    """Where a path recorded in a result file is, as the report reads it
+    (:func:`align.present.reread.resolve_recorded`): as given when absolute; else relative to the result
+    file's folder when that file exists, else relative to the working directory when that one exists,
+    else (neither exists) relative to the result file's folder."""
+    from align.present.reread import resolve_recorded
+
+    return resolve_recorded(result_path, name)
+
+
+def named_inputs(result_path: Path | str) -> list[Path]:
+    """The data files a result file names in its ``inputs`` (the log, plan, static record, capture,
+    positions, segments, mount, manoeuvre, parts file...), resolved as :func:`resolve_named` reads them;
+    for a relative name, also its reading against the working directory when that file exists (an
+    output may overwrite neither). Lenient: a file that is no JSON, or names nothing, names none here.
+
+    Parameters
+    ----------
+    result_path : Path or str
+        A result file (any ``--json`` output).
+
+    Returns
+    -------
+    list of Path
+    """
+    import json
+
+    try:
+        d = json.loads(Path(result_path).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return []
+    inputs = d.get("inputs") if isinstance(d, dict) else None
+    if isinstance(inputs, dict):
+        pairs = list(inputs.items())
+    elif isinstance(inputs, list):
+        pairs = [("logs", v) for v in inputs]
+    else:
+        return []
+    names: list[str] = []
+    for key, value in pairs:
+        for v in value if isinstance(value, list) else [value]:
+            if isinstance(v, str) and v.strip():
+                if key in _FILE_KEYS or resolve_named(result_path, v).is_file():
+                    names.append(v)
+    found: list[Path] = []
+    for name in names:
+        first = resolve_named(result_path, name)
+        for p in (first, Path(name)):
+            if p not in found and (p == first or p.exists()):
+                found.append(p)
     return found
 
 

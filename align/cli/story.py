@@ -5,6 +5,7 @@ Public names
 report, demo, COMMANDS
 """
 
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Annotated
 
@@ -37,11 +38,55 @@ def _when() -> str:
 Repeated = Annotated[list[Path] | None, typer.Option("--calibration", metavar="RESULT.json", help=(
     "A calibration result (calibrate accel, ferraris, gyro or mag --json); repeat for several."))]
 Drift = Annotated[list[Path] | None, typer.Option("--drift", metavar="RESULT.json", help=(
-    "A navigation result whose error growth the report shows (issue 16); repeat for several."))]
+    "A navigation result (drift --json) whose error growth the report shows; repeat for several."))]
+
+
+#: the rate-table log's sample rate: matrix spells it --rate-hz, which the report gives to the static record (--allan)
+LogRate = Annotated[float | None, typer.Option("--log-rate-hz", parser=opt.hertz, metavar="HZ", help=(
+    "Sample rate of the rate-table log (--log), when it has no time column (matrix's --rate-hz; --rate-hz here is "
+    "the static record's). Hz, e.g. 200 or '200 Hz'."))]
 
 
 def _label(flag: str, help: str, metavar: str = "TEXT"):
     return Annotated[str | None, typer.Option(flag, metavar=metavar, help=help)]
+
+
+class LazyParts(Mapping):
+    """The parts table (the presets with the user's parts file laid over them), read on first use: a report
+    reads the parts file only when its mount looks a part up."""
+
+    def __init__(self, option: Path | None) -> None:
+        self.option, self._table = option, None
+
+    def _load(self) -> Mapping:
+        if self._table is None:
+            from align.parts import PARTS
+
+            self._table = parts_table(self.option) or PARTS
+        return self._table
+
+    def __getitem__(self, key):
+        return self._load()[key]
+
+    def __iter__(self):
+        return iter(self._load())
+
+    def __len__(self) -> int:
+        return len(self._load())
+
+
+def _flags() -> frozenset[str]:
+    """The report's option names, so that a note names only flags the report has (others in words)."""
+    import inspect
+
+    known: set[str] = set()
+    for p in inspect.signature(report).parameters.values():
+        for meta in getattr(p.annotation, "__metadata__", ()):
+            first = getattr(meta, "default", None)  # typer takes a str first argument in Annotated as a name
+            for decl in [first] + list(getattr(meta, "param_decls", None) or ()):
+                if isinstance(decl, str) and decl.startswith("-"):
+                    known.update(decl.split("/"))
+    return frozenset(known)
 
 
 def report(
@@ -49,7 +94,8 @@ def report(
     mount: opt.OptInput("--mount", MOUNT_HELP, "MOUNT.toml") = None,
     manoeuvre: opt.OptInput("--manoeuvre", MANOEUVRE_HELP + " With --mount: the budget is checked against it; with "
                             "an alignment: the measured misalignment is.", "MANOEUVRE.toml") = None,
-    log: opt.OptInput("--log", "Rate-table log (time,gyro_x,gyro_y,gyro_z) for the alignment, with --plan.", "LOG") = None,
+    log: opt.OptInput("--log", "Rate-table log for the alignment, with --plan (its columns: --gyro-columns).",
+                      "LOG") = None,
     plan: opt.OptInput("--plan", "Its test plan TOML ([[step]] tables).", "PLAN.toml") = None,
     alignment: opt.OptInput("--alignment", "An alignment result (matrix --json) instead of --log and --plan.",
                             "RESULT.json") = None,
@@ -57,7 +103,8 @@ def report(
                             "the test plan.", "STATIC") = None,
     calibration: Repeated = None,
     drift: Drift = None,
-    title: Annotated[str, typer.Option("--title", metavar="TEXT", help="Title of the report.")] = "IMU alignment report",
+    title: _label("--title", "Title of the report (default by what it reports: 'IMU alignment report', 'IMU "
+                  "calibration report'...).") = None,
     serial: _label("--serial", "Serial number of the unit tested.") = None,
     operator: _label("--operator", "Who ran the test.") = None,
     test_id: _label("--test-id", "Identifier of the test (a work order, a run number).") = None,
@@ -65,6 +112,10 @@ def report(
     rate_hz: opt.RateHz("Sample rate of the static recording, when it has no time column.") = None,
     units: opt.UnitFlag("--units", "Unit of the static recording (an angular rate).") = "deg/s",
     gyro_units: opt.GyroUnits("Unit of the rate-table log (--log).") = "deg/s",
+    gyro_columns: opt.Columns("Columns of the rate-table log (--log): time,x,y,z (x,y,z with --log-rate-hz). Default "
+                              "time,gyro_x,gyro_y,gyro_z; for --alignment, the columns the result records.",
+                              "--gyro-columns", optional=True) = None,
+    log_rate_hz: LogRate = None,
     rate: opt.Text("--rate", "angular_rate", "Table rate for the plan.", "RATE", POSITIVE, "'100 deg/s'",
                    optional=False) = "100 deg/s",
     accuracy: opt.Text("--accuracy", "angle", "Alignment goal for the plan.", "ANGLE", ACCURACY, "'0.1 deg'",
@@ -79,8 +130,11 @@ def report(
 ) -> None:
     """One self-contained HTML report from any subset of results: budget, allowance, alignment, noise, calibrations.
 
-    A summary comes first: every check, its verdict and the number behind it. The exit status is 4 when a
-    check fails (the budget or the measured misalignment over the allowance); the report is written first.
+    A summary comes first: every check, its verdict and the number behind it. The measured misalignment is
+    propagated through the manoeuvre and judged with a guard band of 2 sigma (PASS, WARN within 2 sigma of a
+    limit, FAIL). The exit status is 4 when a check fails; the report is written first. With a measured
+    alignment the measurement governs: the mounting budget against the allowance is then a design check, shown
+    with its verdict, that fails nothing.
     """
     from align.errors import CheckFailed, InputError
 
@@ -88,17 +142,21 @@ def report(
         raise InputError("give {log} and {plan} together", "{log}" if log is None else "{plan}")
     calibrations, drifts = list(calibration or []), list(drift or [])
     check_outputs([mount, manoeuvre, log, plan, alignment, allan_log, *calibrations, *drifts, parts_file(parts)[0],
-                   *data_files(mount, manoeuvre)], out=out)
+                   *data_files(mount, manoeuvre)], out=out,
+                  results=[alignment, *calibrations, *drifts,
+                           allan_log if allan_log is not None and allan_log.suffix.lower() == ".json" else None])
     from align.present.story import make_report
 
     header = {"serial number": serial, "operator": operator, "test": test_id, "date": _when()}
+    given = (skip_rows, comment, delimiter, time_units) != (0, None, None, None)  # else: what a result recorded
     with progress(monte_carlo if mount is not None else 0, "Monte Carlo") as tick:
         done = make_report(
             mount, manoeuvre, log=log, plan=plan, allan=allan_log, allan_columns=columns, allan_rate_hz=rate_hz,
             allan_units=units, gyro_units=gyro_units, table_rate=rate, accuracy=accuracy, monte_carlo=monte_carlo,
-            seed=seed, progress=tick, log_format=opt.log_format(skip_rows, comment, delimiter, time_units),
-            alignment=alignment, calibrations=calibrations, drift=drifts, title=title, header=header,
-            parts=parts_table(parts))
+            seed=seed, progress=tick, log_format=opt.log_format(skip_rows, comment, delimiter, time_units) if given
+            else None, alignment=alignment, calibrations=calibrations, drift=drifts, title=title, header=header,
+            parts=LazyParts(parts) if mount is not None else None, log_columns=gyro_columns, log_rate_hz=log_rate_hz,
+            spell=opt.speller("report", _flags()))
     with outputs() as staged:
         staged.write_text(out, done.page)
     typer.echo(done.text + f"\nreport: {out}")
@@ -122,7 +180,8 @@ def demo(
         for name, result in results.items():
             staged.write_json(out / f"{name}.json", result)
         staged.write_text(out / "report.html", page)
-    typer.echo("imu-align demo (inputs: the reference's Examples 1-3, a simulated static record and rate-table session)\n"
+    typer.echo("imu-align demo (inputs: Examples 1-3 of Looney's 'The Basics of MEMS IMU/Gyroscope Alignment', Analog "
+               "Dialogue; a simulated static record and rate-table session)\n"
                + summary + f"\nwrote {out}/report.html and the JSON results beside it")
 
 

@@ -102,11 +102,17 @@ def c_header(name: str, matrix: np.ndarray, bias: np.ndarray, bias_unit: str, co
     bias_unit : str
         The readings' unit.
     comment : str
-        First lines of the header (what it is, where it came from).
+        First lines of the header (what it is, where it came from); ``written by`` the tool is added to the first
+        unless it names the tool already, and a line restating the convention (``g = M w + b; ...``) is dropped:
+        the header states it once, in full.
     frame : str
         The frame of the corrected rates.
     """
-    preamble = (f"{comment}\nwritten by {TOOL}\n"
+    lines = [ln for ln in comment.splitlines() if ln.strip() and not ln.startswith("g = M w + b")]
+    first = lines[0] if lines else "imu-align alignment"
+    if TOOL not in first:
+        first += f"; written by {TOOL}"
+    preamble = ("\n".join([first, *lines[1:]]) + "\n"  # one statement of the convention: the one below
                 "convention: correcting, w = A (g - b) with A = M^-1 of the model g = M w + b (g raw reading, "
                 "b bias, w true rate); rows of M are gyro axes\n"
                 f"frame: w in {frame}\n"

@@ -149,6 +149,23 @@ def _needed(key: str, value: float | None) -> dict[str, float | None]:
     return {"record_to_identify_h": None if value is None else value / 3600}
 
 
+def _continuous(f: NoiseFit, upper: np.ndarray, sensor: str) -> dict[str, Any]:
+    """Kalibr-style densities, SI: the fitted N and K or, where the record does not identify one, its 95 % upper
+    bound (the number the Kalibr export writes), with ``<key>_is`` saying which."""
+    out: dict[str, Any] = {}
+    for k, key in ((1, "noise_density"), (3, "random_walk")):
+        name = f"{sensor}_{key}"
+        if f.identifiable[k]:
+            out[name], out[f"{name}_is"] = float(f.params[k]), "fitted"
+        elif np.isfinite(upper[k]):
+            out[name], out[f"{name}_is"] = float(upper[k]), ("95 % upper bound: the record does not identify it "
+                                                             "(the fit gives 0)")
+        else:
+            out[name], out[f"{name}_is"] = None, "not identified; no bound stated"
+    out["units"] = "rad/s/sqrt(Hz), rad/s^2/sqrt(Hz)" if sensor == "gyroscope" else "m/s^2/sqrt(Hz), m/s^3/sqrt(Hz)"
+    return out
+
+
 def fit_dict(f: NoiseFit, tu: tuple[str, ...], sensor: str) -> dict[str, Any]:
     """One channel's fit in engineering units, terms named as in :data:`TERM_TABLE`."""
     upper, record = fit_extras(f)
@@ -170,9 +187,7 @@ def fit_dict(f: NoiseFit, tu: tuple[str, ...], sensor: str) -> dict[str, Any]:
             readouts[unit_key] = tu[k]
     d = {"method": getattr(f, "method", FIT_METHOD), "terms": terms, "notes": [note_out(n, sensor) for n in f.notes],
          "ieee_point_readouts": readouts,
-         "continuous": {  # Kalibr-style densities, SI
-             f"{sensor}_noise_density": float(f.params[1]), f"{sensor}_random_walk": float(f.params[3]),
-             "units": "rad/s/sqrt(Hz), rad/s^2/sqrt(Hz)" if sensor == "gyroscope" else "m/s^2/sqrt(Hz), m/s^3/sqrt(Hz)"},
+         "continuous": _continuous(f, upper, sensor),
          "dominant": [term(k).json_key(sensor) for k in f.dominant], "edf": f.edf.tolist()}
     more = {fl.name: _plain(getattr(f, fl.name)) for fl in dataclasses.fields(f) if fl.name not in _KNOWN}
     if more:

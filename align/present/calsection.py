@@ -1,6 +1,8 @@
 """The report's calibration sections: an accelerometer or gyro ``[M | b]`` (multi-position, Ferraris,
-rate table) with its 1-sigma, scale factors and angles in degrees, residuals and held-out checks; a
-magnetometer's hard and soft iron with its quality figures; each with its picture when one was drawn.
+rate table) with its 1-sigma in M's own unit (counts per m/s^2 for readings in counts), the scale factors
+and angles (:func:`align.present.angles.angle_rows`), residuals, held-out checks and a gyro's g-sensitivity in
+the unit the calibration file gives it; a magnetometer's hard and soft iron with its quality figures and the
+angles of its soft iron; each with its picture when one was drawn.
 
 Public names
 ------------
@@ -12,8 +14,8 @@ from __future__ import annotations
 import numpy as np
 
 from align.errors import AlignError
-from align.model import angles
-from align.present.html import Section, esc, image, table
+from align.present.angles import angle_rows
+from align.present.html import Section, angle_table, esc, image, table
 from align.units import DEG, to_unit
 
 _AXES = ("x", "y", "z")
@@ -26,6 +28,18 @@ def _values(v: np.ndarray, u: str, fmt: str = "+.6g") -> list[str]:
     except AlignError:
         shown = np.asarray(v, float)
     return [format(float(x), fmt) for x in np.atleast_1d(shown)]
+
+
+def _sig(v: float, digits: int = 6) -> str:
+    """``v`` signed with ``digits`` significant digits (``+0.000601824``, ``-3.79613e-07``); never ``-0``."""
+    return format(float(v) + 0.0, f"+.{digits}g")
+
+
+def _inverse(unit: str) -> str:
+    """The unit of M^-1 for M's unit: ``counts per m/s^2`` -> ``m/s^2 per count``; ``1`` stays ``1``."""
+    if unit.startswith("counts per "):
+        return unit[len("counts per "):] + " per count"
+    return unit
 
 
 def calibration_section(cal, source: str, picture: bytes | None = None, picture_note: str = "") -> Section:
@@ -42,33 +56,33 @@ def calibration_section(cal, source: str, picture: bytes | None = None, picture_
         Why there is no picture, when there is none.
     """
     u = cal.units
-    ang = angles(cal.M)
-    m_rows = [[f"{a} axis"] + [f"{cal.M[i, j]:+.6f}" + ("" if not np.isfinite(cal.sigma_M[i, j])
-                                                        else f" ± {cal.sigma_M[i, j]:.1e}") for j in range(3)]
+    d = cal.to_dict()
+    m_unit = d["units"].get("M", "1")  # counts per m/s^2 for readings in counts
+    inv_unit = _inverse(m_unit)
+    m_rows = [[f"{a} axis"] + [_sig(cal.M[i, j]) + ("" if not np.isfinite(cal.sigma_M[i, j])
+                                                   else f" ± {cal.sigma_M[i, j]:.2g}") for j in range(3)]
               for i, a in enumerate(_AXES)]
     a_mat = np.linalg.inv(cal.M)
-    a_rows = [[f"{a} axis"] + [f"{a_mat[i, j]:+.6f}" for j in range(3)] for i, a in enumerate(_AXES)]
+    a_rows = [[f"{a} axis"] + [_sig(a_mat[i, j]) for j in range(3)] for i, a in enumerate(_AXES)]
     bias = [f"{b} ± {s}" for b, s in zip(_values(cal.bias, u), _values(cal.sigma_bias, u, ".2g"))]
-    phi = [[f"{'xyz'[i]} axis"] + ["-" if i == j else f"{ang.phi[i, j] / DEG:+.4f}" for j in range(3)] for i in range(3)]
+    stated = "dimensionless" if m_unit == "1" else f"in {m_unit}"
     body = (f"<p>From <code>{esc(source)}</code>: {esc(cal.sensor)}, method <b>{esc(cal.method)}</b>. "
             f"<code>raw = M true + bias</code>, corrected by <code>true = M<sup>-1</sup> (raw - bias)</code>; "
-            f"M is dimensionless (unit 1), the bias in {esc(u)}.</p>"
-            + "<p>M (1-sigma), dimensionless:</p>" + table(["", "x", "y", "z"], m_rows)
-            + "<p>M<sup>-1</sup>, the correction:</p>" + table(["", "x", "y", "z"], a_rows)
+            f"M {esc(stated)}, the bias in {esc(u)}.</p>"
+            + f"<p>M (1-sigma), {esc(stated)}:</p>" + table(["", "x", "y", "z"], m_rows)
+            + f"<p>M<sup>-1</sup>, the correction{'' if inv_unit == '1' else ', in ' + esc(inv_unit)}:</p>"
+            + table(["", "x", "y", "z"], a_rows)
             + table([f"bias [{u}]", "x", "y", "z"], [["bias ± 1-sigma"] + bias])
-            + table(["per axis", "x", "y", "z"], [["scale factor"] + [f"{v:.6f}" for v in ang.scale],
-                                                  ["psi: axis to frame [deg]"] + [f"{v / DEG:.4f}" for v in ang.psi]])
-            + table(["phi_ij [deg]: axis i toward", "x", "y", "z"], phi)
-            + table(["axis to axis [deg]", "delta_xy", "delta_xz", "delta_yz"],
-                    [["delta_ij"] + [f"{v / DEG:+.4f}" for v in ang.delta]]))
+            + angle_table(angle_rows(cal.M, cal.sigma_M, None, m_unit), cal.sensor))
     for what, rows in (("Residuals of the fit (reading - model)", cal.residuals),
                        ("Held-out checks (reading - model)", cal.checks)):
         if rows:
             body += f"<p>{what}, {esc(u)}:</p>" + table(["position", "x", "y", "z"],
                                                           [[k] + _values(v, u, "+.4g") for k, v in rows.items()])
-    if cal.g_sensitivity is not None:
-        body += table(["g-sensitivity K_ga", "x", "y", "z"],
-                      [[f"{a} gyro"] + [f"{v:+.4g}" for v in cal.g_sensitivity[i]] for i, a in enumerate(_AXES)])
+    if cal.g_sensitivity is not None:  # as the calibration file and the terminal give it: the readings' unit per m/s^2
+        kga, k_unit = np.array(d["g_sensitivity"], float), d["units"].get("g_sensitivity", "rad/s per m/s^2")
+        body += (f"<p>g-sensitivity K_ga (<code>raw = M w + K_ga a + bias</code>), in {esc(k_unit)}:</p>"
+                 + table(["", "x", "y", "z"], [[f"{a} gyro"] + [_sig(v, 4) for v in kga[i]] for i, a in enumerate(_AXES)]))
     if picture:
         body += image(picture, f"{cal.sensor} readings over time with the detected static intervals")
     elif picture_note:
@@ -109,6 +123,11 @@ def magnetometer_section(cal, source: str, picture: bytes | None = None, picture
         body += ("<p>Rotation to the accelerometer frame (<code>m_body = R m_cal</code>):</p>"
                  + table(["", "x", "y", "z"], [[f"row {a}"] + [f"{cal.misalignment[i, j]:+.6f}" for j in range(3)]
                                                for i, a in enumerate(_AXES)]))
+    model = getattr(cal, "model_matrix", None)
+    if model is not None:  # as calibrate mag prints them: the angles of M of the model m_raw = M m + hard_iron
+        body += ("<p>Angles of <code>M = (" + ("R " if cal.misalignment is not None else "")
+                 + "soft_iron)<sup>-1</sup></code>, the model <code>m_raw = M m + hard_iron</code>:</p>"
+                 + angle_table(angle_rows(model), "magnetometer"))
     if picture:
         body += image(picture, "magnetometer capture before and after calibration with the predicted heading error")
     elif picture_note:

@@ -27,10 +27,10 @@ from align.calibration.magnetometer import MagCalibration
 from align.calibration.results import CalibrationSet
 from align.errors import InputError
 from align.io.export import TOOL, c_array, c_file, csv_text, kalibr_yaml, lower_rotation, matrix_unit
-from align.model import angles
 from align.noise.job import AllanJob
+from align.present.angles import DEFINITIONS, angle_rows
 from align.results import Result
-from align.units import DEG, to_unit
+from align.units import to_unit
 
 #: the exports, and the result formats each one takes
 EXPORTS: dict[str, tuple[str, ...]] = {
@@ -39,7 +39,7 @@ EXPORTS: dict[str, tuple[str, ...]] = {
     "csv": ("imu-align.allan", "imu-align.alignment", "imu-align.calibration", "imu-align.magnetometer"),
     "imucal": ("imu-align.calibration",),
 }
-_SHORT = {"kalibr": "Kalibr's imu.yaml", "c": "C header", "csv": "CSV table", "imucal": "imucal JSON"}
+_SHORT = {"kalibr": "Kalibr imu.yaml", "c": "C header", "csv": "CSV table", "imucal": "imucal JSON"}
 _KEY = {"accelerometer": "ACCEL", "gyroscope": "GYRO"}
 _CAL_FRAME = "the axes of the calibration positions (the fixture's frame)"
 _ALIGN_FRAME = "the system frame of the test (the rate table's axes)"
@@ -77,15 +77,21 @@ def _calibration_header(cs: CalibrationSet, name: str, where: str) -> str:
             blocks.append(c_array(f"{key}_G_SENSITIVITY", c.g_sensitivity * to_unit(1.0, u),
                                   f"{sensor}: K_ga in {u} per m/s^2 (acc: true specific force, m/s^2)",
                                   f"{where}: {sensor}.g_sensitivity"))
-    units = "; ".join(f"{s} readings in {c.units}" for s, c in cs.sensors.items())
+    units = "; ".join(f"{s} readings and bias in {c.units}, true values in {_true_unit(c)}" for s, c in cs.sensors.items())
     preamble = (f"imu-align calibration ({', '.join(cs.sensors)}) {_source(cs, where)}\n"
                 "convention: correcting, true = A (raw - bias) with A = M^-1 of the model raw = M true + bias "
                 "(gyro: + K_ga acc); rows of M are sensor axes\n"
                 f"frame: true values in {_CAL_FRAME}\n"
-                f"units: {units}; bias in the readings' unit; true values in SI (m/s^2, rad/s) or, for readings in "
-                "counts, A maps counts to SI\n"
+                f"units: {units} (A is dimensionless for readings in a physical unit: true values in the readings' "
+                "unit; for readings in counts A maps counts to SI)\n"
                 "literals: the nearest float (IEEE single) to each value, 9 significant digits")
     return c_file(name, preamble, blocks)
+
+
+def _true_unit(c) -> str:
+    """The unit of ``A (raw - bias)``: the readings' own, or SI for readings in counts (M in counts per SI unit)."""
+    mu = matrix_unit(c.units, c.sensor)
+    return c.units if mu == "1" else mu.removeprefix("counts per ")
 
 
 def _inverse_unit(c) -> str:
@@ -93,16 +99,11 @@ def _inverse_unit(c) -> str:
     return "dimensionless" if mu == "1" else f"the inverse of {mu}"
 
 
-def _mag_matrix(c: MagCalibration) -> np.ndarray:
-    """The whole correcting matrix: ``misalignment soft_iron`` (or ``soft_iron``)."""
-    return c.soft_iron if c.misalignment is None else c.misalignment @ c.soft_iron
-
-
 def _mag_header(c: MagCalibration, name: str, where: str) -> str:
     frame = ("the accelerometer's frame (m_body = misalignment m_cal)" if c.misalignment is not None
              else "the magnetometer's own axes (the soft iron is symmetric: no rotation)")
     what = "soft_iron" if c.misalignment is None else "MISALIGNMENT SOFT_IRON"
-    blocks = [c_array(f"{name}_A", _mag_matrix(c), f"A = {what}, dimensionless: m = A (m_raw - hard_iron)",
+    blocks = [c_array(f"{name}_A", c.correcting, f"A = {what}, dimensionless: m = A (m_raw - hard_iron)",
                       f"{where}: soft_iron"),
               c_array(f"{name}_HARD_IRON", to_unit(c.hard_iron, c.units), f"hard iron in {c.units}", f"{where}: hard_iron")]
     if c.misalignment is not None:  # A is their product; each for reference
@@ -120,15 +121,17 @@ def _mag_header(c: MagCalibration, name: str, where: str) -> str:
 
 # ---------------------------------------------------------------- CSV
 
-def _angle_rows(sensor: str, ang) -> list[list]:
-    xyz = "xyz"
-    rows = [["scale", sensor, a, "", float(s), None, "1"] for a, s in zip(xyz, ang.scale)]
-    rows += [["psi", sensor, a, "", float(v / DEG), None, "deg"] for a, v in zip(xyz, ang.psi)]
-    rows += [["phi", sensor, xyz[i], xyz[j], float(ang.phi[i, j] / DEG), None, "deg"]
-             for i in range(3) for j in range(3) if i != j]
-    rows += [["delta", sensor, p[0], p[1], float(v / DEG), None, "deg"] for p, v in zip(("xy", "xz", "yz"), ang.delta)]
-    rows += [["mounting_rotation", sensor, a, "", float(v / DEG), None, "deg"] for a, v in zip(xyz, ang.mounting_rotvec)]
-    return rows
+def _angle_rows(sensor: str, m, sigma_m=None, mounting=None, unit: str = "1") -> list[list]:
+    """The rows of :func:`align.present.angles.angle_rows` (the layout every output uses): one CSV row per element,
+    ``row``/``column`` the element's axes (``phi`` xy: row x, column y), the scale in M's unit, angles in deg."""
+    keys = {"rotation": "mounting_rotation"}
+    out = []
+    for r in angle_rows(m, sigma_m, mounting, unit):
+        for k, (n, v) in enumerate(zip(r.names, r.values)):
+            sig = None if r.sigmas is None else r.sigmas[k]
+            pair = r.key in ("phi", "delta")
+            out.append([keys.get(r.key, r.key), sensor, n[0], n[1] if pair else "", v, sig, r.unit])
+    return out
 
 
 def _matrix_rows(q: str, sensor: str, m, sigma, unit: str) -> list[list]:
@@ -149,7 +152,7 @@ def _matrix_csv(r: Result, where: str) -> str:
         u = r.units
         rows = (_matrix_rows("M", "gyroscope", r.M, r.sigma_M, "1") + _matrix_rows("A", "gyroscope", r.A, r.sigma_A, "1")
                 + _vector_rows("bias", "gyroscope", to_unit(r.bias, u), to_unit(r.sigma_bias, u), u)
-                + _angle_rows("gyroscope", r.angles))
+                + _angle_rows("gyroscope", r.M, r.sigma_M, r.mounting))
         frame = _ALIGN_FRAME + ("" if np.allclose(r.mounting, np.eye(3)) else "; angles relative to the nominal mounting")
     elif isinstance(r, CalibrationSet):
         rows, frame = [], _CAL_FRAME
@@ -158,22 +161,24 @@ def _matrix_csv(r: Result, where: str) -> str:
             inv = _inverse(c.M, f"{where}: {s}.M")
             rows += (_matrix_rows("M", s, c.M, c.sigma_M, mu) + _matrix_rows("A", s, inv, None, "1" if mu == "1" else f"1/({mu})")
                      + _vector_rows("bias", s, to_unit(c.bias, c.units), to_unit(c.sigma_bias, c.units), c.units)
-                     + _angle_rows(s, angles(c.M)))
+                     + _angle_rows(s, c.M, c.sigma_M, unit=mu))
     else:  # MagCalibration
-        a = _mag_matrix(r)
+        a = r.correcting
         m = _inverse(a, f"{where}: soft_iron")
         rows = (_matrix_rows("M", "magnetometer", m, None, "1") + _matrix_rows("A", "magnetometer", a, None, "1")
                 + _vector_rows("hard_iron", "magnetometer", to_unit(r.hard_iron, r.units),
                                to_unit(r.sigma_hard_iron, r.units), r.units)
                 + _matrix_rows("soft_iron", "magnetometer", r.soft_iron, None, "1")
-                + _angle_rows("magnetometer", angles(m)))
+                + _angle_rows("magnetometer", m))
         frame = "the accelerometer's frame" if r.misalignment is not None else "the magnetometer's own axes"
-    header = (f"{r.FORMAT} {_source(r, where)}\n"
+    header = (f"M, A and the angles {_source(r, where)}\n"
               "convention: M modelling (raw = M true + bias; rows are sensor axes); A = M^-1 correcting "
               "(true = A (raw - bias))\n"
               f"frame: {frame}\n"
-              "units: the unit column (angles in deg; scale = |row of M|); sigma_1 is the 1-sigma, empty when unknown\n"
-              "angles: psi_i = acos(u_i . e_i), phi_ij = asin(u_i . e_j), delta_ij = asin(u_i . u_j) of the rows u_i of M")
+              "units: the unit column (angles in deg; scale = |row of M| in M's unit); sigma_1 is the 1-sigma, empty "
+              "when unknown\n"
+              "angles: " + "; ".join(DEFINITIONS[k] for k in ("scale", "psi", "phi", "delta", "rotation"))
+              + " (u_i = row i of M / |row i|)")
     return csv_text(header, _CSV_COLUMNS, rows)
 
 
@@ -185,7 +190,7 @@ def _allan_csv(job: AllanJob, where: str) -> str:
         f = job.fits[j]
         cols += [f"{n} adev [{u}]", f"{n} ci_low [{u}]", f"{n} ci_high [{u}]"]
         data += [to_unit(r.adev[j], u), to_unit(f.ci_low, u), to_unit(f.ci_high, u)]
-    header = (f"{job.FORMAT} {_source(job, where)}\n"
+    header = (f"Allan deviation curve {_source(job, where)}\n"
               f"overlapping Allan deviation of {job.sensor} data"
               + (f" (pooled curve of {job.runs} runs)" if job.pooled else "") + f" at {r.fs:g} Hz\n"
               f"units: tau in s, deviations in {u}; ci_low/ci_high: 68.3 % chi-square interval\n"
@@ -196,22 +201,41 @@ def _allan_csv(job: AllanJob, where: str) -> str:
 # ---------------------------------------------------------------- Kalibr
 
 def _noise(job: AllanJob, k: int) -> tuple[float, str] | None:
-    """The largest over the channels of term ``k`` (1: N, 3: K), SI; its fitted value, else its 95 % upper bound."""
-    vals, bound = [], False
-    for f in job.fits:
+    """The largest over the channels of term ``k`` (1: N, 3: K), SI, and what it is.
+
+    A channel whose record identifies the term gives its fitted value; one that does not gives the term's
+    one-sided 95 % upper bound (the fit's value there is zero, which Kalibr cannot take). The comment says
+    explicitly when the number written is an upper bound, and of which channels.
+    """
+    vals, bounded = [], []
+    for name, f in zip(job.result.names, job.fits):
         if f.identifiable[k] and np.isfinite(f.params[k]) and f.params[k] > 0:
-            vals.append(float(f.params[k]))
+            vals.append((float(f.params[k]), False, name))
         elif np.isfinite(f.upper[k]) and f.upper[k] > 0:
-            vals.append(float(f.upper[k]))
-            bound = True
+            vals.append((float(f.upper[k]), True, name))
+            bounded.append(name)
     if not vals:
         return None
-    how = "largest of the axes" + ("; a 95 % upper bound where the record does not identify it" if bound else ", fitted")
-    return max(vals), how
+    value, is_bound, name = max(vals)
+    if is_bound:
+        how = (f"95 % UPPER BOUND, not a fitted value: the record does not identify it ({', '.join(bounded)}; the "
+               f"fit gives 0 there); the largest over the axes, from {name}")
+    else:
+        how = f"fitted, the largest over the axes ({name})" + (
+            f"; a 95 % upper bound stands in for {', '.join(bounded)}, not identified" if bounded else "")
+    return value, how
 
 
 def _flat(m: np.ndarray) -> str:
     return "[" + ", ".join("[" + ", ".join(f"{v:.9g}" for v in row) + "]" for row in m) + "]"
+
+
+def _physical(cs: CalibrationSet, what: str, where: str) -> None:
+    """Refuse readings in counts: ``what`` takes a dimensionless ``M`` (readings in a physical unit)."""
+    for s, c in cs.sensors.items():
+        if matrix_unit(c.units, s) != "1":
+            raise InputError(f"the {s} readings are in {c.units}: {what} is dimensionless; calibrate with the "
+                             "size of one count as the unit", f"{where}: {s}")
 
 
 def _kalibr_intrinsics(r: Result, where: str) -> tuple[dict, str]:
@@ -219,10 +243,7 @@ def _kalibr_intrinsics(r: Result, where: str) -> tuple[dict, str]:
         low, rot = lower_rotation(r.M, f"{where}: M")
         return ({"gyroscopes": {"M": low, "A": np.zeros((3, 3)), "C_gyro_i": rot}},
                 f"IMU frame i = {_ALIGN_FRAME}; gyroscopes.A (g-sensitivity) not estimated: zero")
-    for s, c in r.sensors.items():
-        if matrix_unit(c.units, s) != "1":
-            raise InputError(f"the {s} readings are in {c.units}: Kalibr's M is dimensionless; calibrate with the "
-                             "size of one count as the unit", f"{where}: {s}")
+    _physical(r, "Kalibr's M", where)
     out, rot_a, note = {}, np.eye(3), f"IMU frame i = {_CAL_FRAME}"
     if "accelerometer" in r.sensors:
         low, rot_a = lower_rotation(r.sensors["accelerometer"].M, f"{where}: accelerometer.M")
@@ -272,7 +293,7 @@ def _kalibr(results: list[tuple[Result, str]], rostopic: str) -> str:
             if got is None:
                 missing.append(f"{prefix}_{key}")
             else:
-                scalars.append((f"{prefix}_{key}", got[0], f"{unit}, {what} (Allan fit, IEEE 952), {got[1]}"))
+                scalars.append((f"{prefix}_{key}", got[0], f"{unit}, {what} (Allan fit, IEEE 952): {got[1]}"))
     sensors, frame = ({}, "IMU frame i = the sensor axes of the Allan records") if intrinsics is None else \
         _kalibr_intrinsics(*intrinsics)
     srcs = "; ".join(f"{Path(w).name} ({r.FORMAT})" for r, w in results)
@@ -283,7 +304,9 @@ def _kalibr(results: list[tuple[Result, str]], rostopic: str) -> str:
         header += ["convention: modelling, Kalibr's direction (scale-misalignment model): a_meas = M_accel a_i + b_a, "
                    "w_meas = M_gyro C_gyro_i w_i + A_gyro C_gyro_i a_i + b_g; M lower triangular = imu-align's M "
                    "(raw = M true + bias) split as M = L C; imu-align's A = M^-1 (correcting) is not written; biases "
-                   "are estimated by Kalibr, not written", f"frame: {frame}"]
+                   "are estimated by Kalibr, not written", f"frame: {frame}",
+                   "intrinsics for reference and comparison only: Kalibr does not read accelerometers/gyroscopes "
+                   "from its input imu.yaml (its calibration starts from M = I, C = I, A = 0); it uses the noise keys"]
     else:
         header.append(f"convention: noise only (no intrinsics); frame: {frame}")
     if missing:
@@ -341,6 +364,7 @@ def export_text(results: list[tuple[Result, str]], to: str, name: str | None = N
     if missing:
         raise InputError(f"imucal's format needs an accelerometer and a gyroscope; this calibration has no "
                          f"{' or '.join(missing)}", where)
+    _physical(r, "imucal's K R", where)
     for s, c in r.sensors.items():
         _inverse(c.M, f"{where}: {s}.M")  # imucal's K R = M: a singular M has no R
     return json.dumps(r.as_imucal(), indent=2) + "\n"

@@ -10,7 +10,7 @@ test plan), :mod:`align.present.alignsection` (electronic alignment), :mod:`alig
 
 Public names
 ------------
-Section, esc, image, table, header_block, html_report, inputs_section, budget_section, allowance_section
+Section, esc, image, table, angle_table, header_block, html_report, inputs_section, budget_section, allowance_section
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ th{background:#f3f3f3}td.l,th.l{text-align:left}.pass{color:#070}.fail{color:#b0
 img{max-width:100%;border:1px solid #ddd;margin:.5em 0}code,pre{background:#f6f6f6;padding:.1em .3em}
 .note{color:#555;font-size:.92em}.info{color:#345}
 .banner{font-size:1.15em;padding:.5em .8em;border:2px solid;border-radius:4px}.banner.pass{background:#eef8ee}
-.banner.fail{background:#fdeeee}.banner.info{background:#f2f5f8;border-color:#9ab}
+.banner.fail{background:#fdeeee}.banner.info{background:#f2f5f8;border-color:#9ab}.banner.warn{background:#fdf6e8}
 table.header td{text-align:left;border:none;padding:.1em 1em .1em 0}table.header td:first-child{color:#555}
 """
 
@@ -70,6 +70,33 @@ def table(header: list[str], rows: list[list], left: int = 1) -> str:
     return f"<table><tr>{head}</tr>{''.join(body)}</table>"
 
 
+def angle_table(rows, sensor: str = "sensor", mounting: bool = False) -> str:
+    """The scale factors and misalignment angles as :func:`align.present.angles.angle_rows` lays them out (the
+    cells as the terminal prints them), then each row's definition.
+
+    Parameters
+    ----------
+    rows : list of AngleRow
+    sensor : str
+        What the axes are (``"gyro"``, ``"accelerometer"``), for the definitions.
+    mounting : bool
+        Whether the angles are relative to a nominal mounting ``N`` (those of ``M N^T``).
+    """
+    from align.present.angles import DEFINITIONS
+
+    width = max(len(r.names) for r in rows)
+    body = [[r.label, "" if r.unit == "1" else r.unit] + r.text() + [""] * (width - len(r.names)) for r in rows]
+    defs = "; ".join(DEFINITIONS[r.key] for r in rows if r.key in DEFINITIONS)
+    sig = any(r.sigmas is not None for r in rows)
+    return (table(["", "unit", "each element" + (" ± 1-sigma" if any(r.sigmas is not None for r in rows) else "")]
+                  + [""] * (width - 1), body, left=2)
+            + f'<p class="note">Rows of M are {esc(sensor)} axes; <code>u_i</code> is row i of '
+            + ("M N<sup>T</sup>" if mounting else "M") + " scaled to unit length, <code>e_j</code> the reference "
+            f"axes; {esc(defs)}"
+            + (". The 1-sigma by first-order propagation of sigma(M), its elements taken independent." if sig else ".")
+            + "</p>")
+
+
 def header_block(header: dict | None) -> str:
     """The report's identification under its title: ``header`` maps a label (``"serial number"``,
     ``"operator"``, ``"date"``) to its text; empty values are left out; the tool's version is always given."""
@@ -79,11 +106,16 @@ def header_block(header: dict | None) -> str:
     return f'<table class="header">{cells}</table>'
 
 
-def html_report(title: str, sections: list[Section], header: dict | None = None) -> str:
-    """The whole page: title, identification (:func:`header_block`), the convention, then the sections in order."""
+def html_report(title: str, sections: list[Section], header: dict | None = None,
+                conventions: list[str] | None = None) -> str:
+    """The whole page: title, identification (:func:`header_block`), the conventions of the results shown
+    (default: the gyro alignment's, :data:`align.CONVENTION`), then the sections in order."""
+    conventions = [CONVENTION] if conventions is None else conventions
+    stated = ("Convention" + ("s" if len(conventions) > 1 else "") + ": "
+              + "; ".join(f"<code>{esc(c)}</code>" for c in conventions) + ". ") if conventions else ""
     parts = [f"<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\"><title>{esc(title)}</title>",
              f"<style>{_CSS}</style></head><body><h1>{esc(title)}</h1>", header_block(header),
-             f'<p class="note">Convention everywhere: <code>{esc(CONVENTION)}</code>; angles in degrees unless stated.</p>']
+             f'<p class="note">{stated}Angles in degrees unless stated.</p>']
     for s in sections:
         parts.append(f"<h2>{esc(s.title)}</h2>{s.body}")
     parts.append("</body></html>")
@@ -129,6 +161,8 @@ def budget_section(b, histogram_png: bytes | None, assembly_png: bytes | None) -
         body += image(histogram_png, "Monte Carlo histogram of the per-axis misalignment")
     if assembly_png:
         body += image(assembly_png, "assembly resting on its ledges, tilt exaggerated")
+    body += ('<p class="note">Equation numbers are those of M. Looney, "The Basics of MEMS IMU/Gyroscope Alignment", '
+             "Analog Dialogue (Analog Devices).</p>")
     return Section("Mounting-misalignment budget", body)
 
 
@@ -161,13 +195,14 @@ def allowance_section(allow, margins=None, basis: str = "rss") -> Section:
             allowed = "unconstrained" if not np.isfinite(r.allowed) else f"{r.allowed / DEG:.4f}"
             margin = "-" if not np.isfinite(r.allowed) else f"{r.margin / DEG:+.4f}"
             mrows.append([r.element, f"{r.predicted / DEG:.4f}", allowed, margin,
-                          ("pass", "pass") if r.ok else ("FAIL", "fail")])
+                          ("PASS", "pass") if r.ok else ("FAIL", "fail")])
         ok = all(r.ok for r in margins)
-        body += (f"<p>Budget ({esc(basis)}) against the allowance: <b class=\"{'pass' if ok else 'fail'}\">"
-                 f"{'PASS' if ok else 'FAIL'}</b></p>"
+        body += (f"<p>Budget ({esc(basis)}) against the allowance, a design check (what the mounting is predicted to "
+                 "give, each element against its allowance alone): "
+                 f"<b class=\"{'pass' if ok else 'fail'}\">{'PASS' if ok else 'FAIL'}</b></p>"
                  + table(["element", "predicted [deg]", "allowed [deg]", "margin [deg]", "result"], mrows))
     ag = d["agreement"]
-    body += (f'<p class="note">At {esc(ag["element"])}: closed form (Eq 11-13) '
+    body += (f'<p class="note">At {esc(ag["element"])}: closed form (Looney\'s Eq 11-13) '
              + ", ".join(f"{k} {v:+.5f}" for k, v in ag["closed_form_deg"].items())
              + " deg; attitude propagation " + ", ".join(f"{k} {v:+.5f}" for k, v in ag["propagated_deg"].items())
              + f" deg ({esc(ag['note'])}).</p>")

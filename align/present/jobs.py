@@ -23,7 +23,8 @@ from align.errors import AlignError
 from align.io import LogFormat, read_sensor_log, read_static, read_toml
 from align.present.html import Section
 from align.present.presets import preset_lines
-from align.present.verdicts import FAIL, INFO, PASS, WARN, Verdict, measured_margins, measured_section, worst
+from align.present.reread import LOG_FIELDS, Said, in_words, read_capture, statics_picture, template
+from align.present.verdicts import FAIL, INFO, PASS, WARN, Verdict, worst
 from align.units import DEG, DEG_H, parse_unit
 from align.units import parse_quantity as q
 
@@ -120,8 +121,8 @@ def manoeuvre_job(rep: Report, manoeuvre: Path, budget=None, mount=None, basis: 
             rep.verdicts.append(Verdict(
                 f"mounting budget ({basis}) vs allowance", PASS if table.passed else FAIL,
                 f"{w.element} margin {w.margin / DEG:+.4f} deg", w.margin / DEG,
-                f"predicted {_deg(w.predicted)} against {_deg(w.allowed)} allowed (smallest margin of 9 elements)"
-                + ("" if table.passed else f"; over: {', '.join(table.failed)}")))
+                f"design check: predicted {_deg(w.predicted)} against {_deg(w.allowed)} allowed (smallest margin of 9 "
+                "elements)" + ("" if table.passed else f"; over: {', '.join(table.failed)}"), design=True))
         else:
             rep.verdicts.append(Verdict("mounting budget", INFO, f"RSS total {budget.total / DEG:.4f} deg",
                                         budget.total / DEG, "no manoeuvre given: nothing to check it against"))
@@ -130,26 +131,37 @@ def manoeuvre_job(rep: Report, manoeuvre: Path, budget=None, mount=None, basis: 
     return allow
 
 
-def _reread_log(rep: Report, r, log_format: LogFormat | None):
-    """The rate-table log an alignment result names, read as it was (None and why not, when it cannot be)."""
-    inp = r.inputs or {}
-    log = inp.get("log")
-    if not log:
-        return None, "no segmentation picture: the result names no log"
-    cols = [c.strip() for c in str(inp.get("columns") or "time,gyro_x,gyro_y,gyro_z").split(",")]
-    time_col, cols = (cols[0], cols[1:]) if len(cols) == 4 else (None, cols)
-    fmt = log_format or LogFormat(**{k: inp[k] for k in ("skip_rows", "comment", "delimiter") if inp.get(k) is not None})
+def _log_columns(columns: str | None, rate_hz: float | None) -> tuple[str | None, list[str]]:
+    """The report's rate-table log columns: ``time,x,y,z``, or ``x,y,z`` with a sample rate."""
+    from align.errors import InputError
+
+    names = [c.strip() for c in (columns or "time,gyro_x,gyro_y,gyro_z").split(",") if c.strip()]
+    if len(names) != (3 if rate_hz is not None else 4):
+        raise InputError("give four names time,x,y,z (three, x,y,z, with {log_rate_hz})", "{gyro_columns}")
+    return (None, names) if rate_hz is not None else (names[0], names[1:])
+
+
+def _read_log(rep: Report, log: Path, gyro_units: str, log_format: LogFormat | None, columns: str | None,
+              rate_hz: float | None):
+    """The rate-table log as the report's options say; its errors name the report's own inputs."""
+    time_col, cols = _log_columns(columns, rate_hz)
     try:
-        return read_sensor_log(log, cols, inp.get("gyro_units") or r.units, time_col, inp.get("rate_hz"),
-                               log_format=fmt), ""
+        return read_sensor_log(rep.source(log), cols, gyro_units, time_col, rate_hz, log_format=log_format)
     except AlignError as exc:
-        return None, f"no segmentation picture: its log could not be read again ({exc})"
+        raise type(exc)(template(exc, LOG_FIELDS)) from None
 
 
 def alignment_job(rep: Report, allow, log: Path | None = None, plan: Path | None = None, result: Path | None = None,
-                  gyro_units: str = "deg/s", log_format: LogFormat | None = None) -> None:
-    """The electronic alignment from a log and its plan, or from a result file; its angles against the allowance."""
+                  gyro_units: str = "deg/s", log_format: LogFormat | None = None, columns: str | None = None,
+                  rate_hz: float | None = None) -> None:
+    """The electronic alignment from a log and its plan, or from a result file; the measured misalignment
+    against the allowance (:mod:`align.present.measured`).
+
+    ``log_format``, ``columns`` (``time,x,y,z``; ``x,y,z`` with ``rate_hz``) and ``rate_hz``: how to read the log
+    (None: a plain CSV ``time,gyro_x,gyro_y,gyro_z``); for a result file, None keeps what it recorded.
+    """
     from align.present.alignsection import alignment_section
+    from align.present.reread import reread_alignment_log
     from align.present.segplot import segmentation_plot_png
 
     if result is not None:
@@ -157,7 +169,7 @@ def alignment_job(rep: Report, allow, log: Path | None = None, plan: Path | None
         from align.results import load_result
 
         r = load_result(rep.source(result), (AlignmentResult,))
-        got, why = _reread_log(rep, r, log_format)
+        got, why = reread_alignment_log(Path(result), r, log_format, columns, rate_hz)
         png = None if got is None else segmentation_plot_png(got.t, got.data, r, r.units)
         rep.inputs["alignment result"] = (str(result), "")
     else:
@@ -165,26 +177,27 @@ def alignment_job(rep: Report, allow, log: Path | None = None, plan: Path | None
         from align.alignment.plan import Plan
 
         the_plan = Plan.from_dict(read_toml(rep.source(plan)), str(plan))
-        got = read_sensor_log(rep.source(log), ["gyro_x", "gyro_y", "gyro_z"], gyro_units, log_format=log_format)
+        got = _read_log(rep, log, gyro_units, log_format, columns, rate_hz)
         r = align(got.t, got.data, the_plan, units=got.shown, where=str(log))
         r = r.replace(notes=r.notes + tuple(filter(None, [got.time_note()])),
-                      inputs={"log": str(log), "plan": str(plan), "gyro_units": gyro_units, **got.inputs()})
+                      inputs={"log": str(log), "plan": str(plan), "gyro_units": gyro_units,
+                              "columns": columns or "time,gyro_x,gyro_y,gyro_z", "rate_hz": rate_hz, **got.inputs()})
         png, why = segmentation_plot_png(got.t, got.data, r, r.units), ""
         rep.inputs["rate-table log"] = (str(log), "")
         rep.inputs["plan"] = (str(plan), rep.text(plan))
-    section = alignment_section(r, png)
-    if why:
-        section = Section(section.title, section.body + f'<p class="note">{why}</p>')
-    rep.add("alignment", section)
+    rep.add("alignment", alignment_section(r, png, why))
     rep.results["alignment"] = r
     ang = r.angles
     counts: dict[str, int] = {}
     for c in r.checks:
         counts[c.status] = counts.get(c.status, 0) + 1
+    n_mo = len(r.motions)
     rep.lines.append(f"alignment: psi = {', '.join(f'{v / DEG:.3f}' for v in ang.psi)} deg, "
                      f"sigma(M) <= {np.nanmax(r.sigma_M):.1e}, "
                      f"checks: {', '.join(f'{n} {s}' for s, n in counts.items())}"
-                     + (f"; {len(r.motions)} motion(s) no step claimed, ignored" if r.motions else ""))
+                     + (f"; {n_mo} motion{'s' if n_mo != 1 else ''} that no step claimed, ignored" if n_mo else ""))
+    if why:
+        rep.lines.append(Said("  " + why))
     warned = [c.name for c in r.checks if c.status == "warn"]
     rep.verdicts.append(Verdict("alignment self-checks", WARN if warned else PASS,
                                 f"{counts.get('pass', 0)} of {len(r.checks)} pass", float(counts.get("pass", 0)),
@@ -196,19 +209,22 @@ def alignment_job(rep: Report, allow, log: Path | None = None, plan: Path | None
                                     ang.psi[k] / DEG, "the largest axis-to-frame angle; no manoeuvre given to check "
                                     "it against"))
         return
+    _measured(rep, r, allow)
+
+
+def _measured(rep: Report, r, allow) -> None:
+    """The measured misalignment propagated through the manoeuvre (the verdict), each element alone (the diagnosis)."""
+    from align.present.measured import describe, measured_margins, measured_section, output_margins
+
+    outputs = output_margins(r.M, r.sigma_M, r.mounting, allow.manoeuvre)
     rows = measured_margins(r, allow)
-    ok = all(x.ok for x in rows)
-    w = worst(rows)
-    rep.add("measured", measured_section(rows, "1-sigma by first-order propagation of sigma(M), its elements taken "
-                                               "independent; the angles are relative to the nominal mounting."))
+    status, w, detail = describe(outputs, rows)
+    rep.add("measured", measured_section(outputs, rows))
     rep.measured = rows
-    rep.verdicts.append(Verdict(
-        "measured misalignment vs allowance", PASS if ok else FAIL, f"{w.element} margin {w.margin / DEG:+.4f} deg",
-        w.margin / DEG, f"measured {w.measured / DEG:+.4f} ± {w.sigma / DEG:.4f} deg against {w.allowed / DEG:.4f} deg "
-        "allowed (smallest margin of 9 elements)" + ("" if ok else "; over: " + ", ".join(x.element for x in rows
-                                                                                          if not x.ok))))
-    rep.lines.append(f"measured vs allowance: {'PASS' if ok else 'FAIL'} ({w.element} {w.measured / DEG:+.4f} "
-                     f"± {w.sigma / DEG:.4f} deg, allowed {w.allowed / DEG:.4f} deg)")
+    rep.verdicts.append(Verdict("measured misalignment vs allowance", status,
+                                f"output {w.output} margin {w.margin / DEG:+.4f} deg", w.margin / DEG, detail))
+    rep.lines.append(f"measured vs allowance: {status} (output {w.output}: error {w.error / DEG:.4f} "
+                     f"± {w.sigma / DEG:.4f} deg, limit {w.limit / DEG:.4f} deg; guard band {w.k:g} sigma)")
 
 
 def allan_job(rep: Report, allan: Path, columns: str, rate_hz: float | None, units: str, table_rate: str,
@@ -257,24 +273,6 @@ def allan_job(rep: Report, allan: Path, columns: str, rate_hz: float | None, uni
                                     "the worst channel's random walk (IEEE point readout)"))
 
 
-def _capture(rep: Report, inputs: dict, columns: str, units_key: str, dim: str):
-    """The raw capture a calibration names, in SI (None and why not, when it cannot be read again)."""
-    from align.io import read_columns
-    from align.units import parse_scale
-
-    log = inputs.get("log")
-    if not log:
-        return None, None, "no picture: the calibration names no log"
-    try:
-        names = [c.strip() for c in str(inputs.get("columns") or columns).split(",")]
-        fmt = LogFormat(**{k: inputs[k] for k in ("skip_rows", "comment", "delimiter") if inputs.get(k) is not None})
-        scale, _ = parse_scale(str(inputs.get(units_key) or "counts"), dim, "{units}")
-        header, data = read_columns(log, names, log_format=fmt)
-        return header, data * np.where(np.array([n.lower().startswith("time") for n in header]), 1.0, scale), ""
-    except AlignError as exc:
-        return None, None, f"no picture: the capture {log} could not be read again ({exc})"
-
-
 def calibration_job(rep: Report, path: Path) -> None:
     """A calibration result (accelerometer, Ferraris, gyro, magnetometer): its section, picture and summary number."""
     from align.calibration.magnetometer import MagCalibration
@@ -289,20 +287,22 @@ def calibration_job(rep: Report, path: Path) -> None:
     if isinstance(res, MagCalibration):
         from align.present.calplots import magnetometer_png
 
-        _, raw, why = _capture(rep, res.inputs, "mag_x,mag_y,mag_z", "mag_units", "magnetic_field")
+        _, raw, why = read_capture(Path(path), res.inputs, "mag_x,mag_y,mag_z", "mag_units", "magnetic_field")
         png = None
         if raw is not None:
             png, why = magnetometer_png(raw[:, -3:], res), ""
-        rep.add("calibration", magnetometer_section(res, str(path), png, why))
+        rep.add("calibration", magnetometer_section(res, str(path), png, in_words(why)))
         rep.verdicts.append(Verdict(f"magnetometer ({name})", INFO, f"heading error {res.heading_error / DEG:.3f} deg",
                                     res.heading_error / DEG, f"predicted, 1 sigma; field spread {100 * res.spread_before:.2f} % "
                                     f"before, {100 * res.spread_after:.2f} % after"))
         rep.lines.append(f"magnetometer {path}: predicted heading error {res.heading_error / DEG:.3f} deg, "
                          f"spread {100 * res.spread_after:.2f} % after")
+        if why:
+            rep.lines.append(Said("  " + why))
         return
     for kind, cal in res.sensors.items():
-        png, why = _statics_picture(res.inputs, cal)
-        rep.add("calibration", calibration_section(cal, str(path), png, why))
+        png, why = statics_picture(Path(path), res.inputs, cal)
+        rep.add("calibration", calibration_section(cal, str(path), png, in_words(why)))
         pool = dict(cal.checks) or dict(cal.residuals)
         what = "held-out check" if cal.checks else "residual"
         worst_v = max((float(np.abs(v).max()) for v in pool.values()), default=float("nan"))
@@ -311,36 +311,18 @@ def calibration_job(rep: Report, path: Path) -> None:
         factor, shown = display_unit(cal.units)
         rep.verdicts.append(Verdict(f"{kind} calibration ({name})", INFO,
                                     f"largest {what} {worst_v / factor:.3g} {shown}", worst_v / factor,
-                                    f"{cal.method}; {len(pool)} position(s)"))
+                                    f"{cal.method}; {_count(pool, cal.sensor)}"))
         rep.lines.append(f"{kind} calibration {path}: {cal.method}, largest {what} {worst_v / factor:.3g} {shown}")
+        if why and png is None:
+            rep.lines.append(Said("  " + why))
 
 
-def _statics_picture(inputs: dict, cal):
-    """The static intervals of an accelerometer session, detected again from the log the calibration names."""
-    if cal.sensor != "accelerometer" or "positions" not in inputs:
-        return None, ""
-    from align.calibration.accel import StaticDetector, session_intervals
-    from align.io import read_sensor_log
-    from align.present.calplots import accel_statics_png
-
-    cols = [c.strip() for c in str(inputs.get("columns") or "time,acc_x,acc_y,acc_z").split(",")]
-    time_col, cols = (cols[0], cols[1:]) if len(cols) == 4 else (None, cols)
-    try:
-        fmt = LogFormat(**{k: inputs[k] for k in ("skip_rows", "comment", "delimiter", "time_units")
-                           if inputs.get(k) is not None})
-        got = read_sensor_log(inputs["log"], cols, str(inputs.get("accel_units") or cal.units), time_col,
-                              inputs.get("rate_hz"), expect="acceleration", log_format=fmt, counts=True)
-    except (AlignError, KeyError) as exc:
-        return None, f"no picture: the log could not be read again ({exc})"
-    det = inputs.get("detector") or {}
-    detector = StaticDetector(**{k: det[k] for k in ("window_s", "factor", "init_static_s", "min_static_s") if k in det})
-    try:
-        spec = None if inputs.get("positions") is None else read_toml(inputs["positions"])
-        iv = session_intervals(got.t, got.data, spec, detector, str(inputs.get("positions")))
-    except AlignError as exc:
-        return None, f"no picture: the session's intervals could not be found again ({exc})"
-    note = "" if det else "static intervals detected again with the default detector settings (the file records none)"
-    return accel_statics_png(got.t, got.data, iv, cal.units), note
+def _count(pool: dict, sensor: str) -> str:
+    """``10 attitudes``, ``6 rotations``: the residuals' own word (``attitude 1``) or the sensor's usual one."""
+    first = next(iter(pool), "")
+    word = first.split()[0] if " " in first and first.split()[-1].isdigit() else (
+        "rotation" if sensor == "gyroscope" else "position")
+    return f"{len(pool)} {word}{'' if len(pool) == 1 else 's'}"
 
 
 def drift_job(rep: Report, path: Path) -> None:

@@ -3,7 +3,9 @@
 :func:`drift_plot_png` draws a :class:`~align.navigation.result.DriftResult` as nine panels (roll,
 pitch, heading; north, east, down velocity; north, east, down position) against time: the Monte
 Carlo mean, its 1-sigma and 3-sigma envelopes and, for a static mission, the closed forms' +/- 1
-sigma and 3 sigma. :func:`navigation_section` is the report's section; :func:`drift_summary` the
+sigma and 3 sigma. The down channels' second-order part (``g eps^2 / 2`` of a tilt error) is
+one-signed: there the envelopes are the runs' percentiles (central 68.27 % and 99.73 %), not
+mean +/- k sigma, so that no band shows values no run reaches. :func:`navigation_section` is the report's section; :func:`drift_summary` the
 terminal's.
 
 Public names
@@ -49,9 +51,17 @@ def drift_plot_png(result) -> bytes:
         for col, name in enumerate(names):
             ax = axes[row, col]
             mean, sigma = result.component(group, name)
-            ax.fill_between(x, mean - 3 * sigma, mean + 3 * sigma, color="tab:blue", alpha=0.15, lw=0,
-                            label="mean +/- 3 sigma")
-            ax.fill_between(x, mean - sigma, mean + sigma, color="tab:blue", alpha=0.35, lw=0, label="mean +/- 1 sigma")
+            pct = None
+            if name == "down" and result.down_percentiles is not None:
+                pct = result.down_percentiles[:, :, 0 if group == "velocity_m_s" else 1]
+            if pct is None:
+                ax.fill_between(x, mean - 3 * sigma, mean + 3 * sigma, color="tab:blue", alpha=0.15, lw=0,
+                                label="mean +/- 3 sigma")
+                ax.fill_between(x, mean - sigma, mean + sigma, color="tab:blue", alpha=0.35, lw=0,
+                                label="mean +/- 1 sigma")
+            else:  # one-signed second order: the runs' percentiles
+                ax.fill_between(x, pct[0], pct[-1], color="tab:orange", alpha=0.2, lw=0, label="central 99.73 % of runs")
+                ax.fill_between(x, pct[1], pct[-2], color="tab:orange", alpha=0.4, lw=0, label="central 68.27 % of runs")
             ax.plot(x, mean, color="tab:blue", lw=1.2, label="Monte Carlo mean")
             if result.closed is not None:
                 cf = result.closed[:, row * 3 + col] * GROUPS[group][1]
@@ -59,7 +69,10 @@ def drift_plot_png(result) -> bytes:
                 ax.plot(x, -cf, "k--", lw=0.9)
                 ax.plot(x, 3 * cf, "k:", lw=0.9)
                 ax.plot(x, -3 * cf, "k:", lw=0.9)
-            ax.set_title(_name(group, name), fontsize=10)
+            ax.set_title(_name(group, name) + (" (percentiles of the runs)" if pct is not None else ""),
+                         fontsize=10)
+            if pct is not None and row == 2:
+                ax.legend(handles=ax.get_legend_handles_labels()[0][:2], fontsize=7, loc="upper left")
             ax.grid(alpha=0.3)
             if col == 0:
                 ax.set_ylabel(f"{title} ({unit})")
@@ -128,7 +141,7 @@ def drift_summary(result) -> str:
     for row in _final_rows(result):
         lines.append(f"{row[0]:<26}{row[1]:>12}{row[2]:>12}{row[3]:>12}")
     lines.append(f"which error dominates when ({result.dominance_method}):")
-    lines += ["  " + line for line in result.dominance.splitlines()]
+    lines += ["  " + line for line in result.dominance.splitlines()] or ["  none: no error term grows on this mission"]
     lines += [f"note: {n}" for n in result.notes]
     return "\n".join(lines)
 

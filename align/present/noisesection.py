@@ -1,5 +1,5 @@
 """The report's noise section: the Allan deviation's fitted terms and IEEE point readouts with their
-uncertainties, the seed's noise figures (bias, bias stability, repeatability) and the test plan.
+uncertainties, the noise figures of He, Li and Fu (2023: bias, bias stability, repeatability) and the test plan.
 
 Public names
 ------------
@@ -69,11 +69,11 @@ def figure_rows(d: dict) -> list[list]:
         for period, v in fig["bias_stability"].items():
             p = float(period.split()[0])
             s = stability_sigma(v, record, p)
-            rows.append([name, f"bias stability, {period} averages (seed 002 Eq 7)", f"{v:.4g}",
+            rows.append([name, f"bias stability: std of the {period} means", f"{v:.4g}",
                          "not enough windows" if not math.isfinite(s) else
                          f"± {s:.2g} (1 sigma, {math.floor(record / p)} windows)", u])
         rep = (d.get("repeatability") or {}).get(name)
-        rows.append([name, "bias repeatability, run to run (seed 002 Eq 8)",
+        rows.append([name, "bias repeatability: std of the run biases",
                      "not measured" if rep is None else f"{rep:.4g}",
                      "one run only: record several runs (power cycles) to measure it" if rep is None else
                      f"std of {d['runs']} run biases", u])
@@ -99,7 +99,9 @@ def allan_section(job: AllanJob | None, plot_png: bytes | None, plan: PlanResult
         body += (f"<p>{runs}data in {esc(u['adev'])}; confidence band {esc(u['ci'])}. A term's value is given only "
                  "where the record identifies it; otherwise its 95 % upper bound.</p>"
                  + table(["channel", "term", "value", "uncertainty or bound", "unit"], rows, left=2)
-                 + "<p>Noise figures (seed 002):</p>"
+                 + "<p>Noise figures as He, Li and Fu define them (Electronics Optics &amp; Control 30(7), 2023, "
+                 "pp. 15-20): the bias is the mean reading, the bias stability the spread of the means over windows "
+                 "of the stated length, the repeatability the spread of the biases of separate runs.</p>"
                  + table(["channel", "figure", "value", "uncertainty", "unit"], figure_rows(d), left=2))
     if plot_png:
         body += image(plot_png, "Allan deviation with confidence band, fit, target and averaging time")

@@ -22,7 +22,7 @@ _SPAN_STYLE = {
     "step": {"facecolor": "#f6c343", "alpha": 0.35, "label": "plan step (dwell or turn)"},
     "static": {"facecolor": "#8fd1c4", "alpha": 0.35, "label": "static period"},
     "motion": {"facecolor": "#d9c2ec", "edgecolor": "#7b3f9e", "hatch": "///", "alpha": 0.55,
-               "label": "motion no step claimed (ignored)"},
+               "label": "motion that no step claimed (ignored)"},
     "ramp": {"facecolor": "0.80", "alpha": 0.45, "label": "ramp (moving, not used)"},
 }
 _STEP_NAME = re.compile(r"^step (\d+) \((.*)\)$")
@@ -255,7 +255,8 @@ def segmentation_plot_png(t: np.ndarray, g: np.ndarray, result, units: str = "de
     count = {k: sum(s.kind == k for s in spans) for k in _SPAN_STYLE}
     strip.set_title(f"Segmentation of {len(t):,} samples: " + ", ".join(_count(count[k], *words) for k, words in (
         ("step", ("plan step", "plan steps")), ("static", ("static period", "static periods")),
-        ("motion", ("motion no step claimed", "motions no step claimed")), ("ramp", ("ramp", "ramps")))), fontsize=9)
+        ("motion", ("motion that no step claimed", "motions that no step claimed")), ("ramp", ("ramp", "ramps")))
+        if count[k] or k == "step"), fontsize=9)  # kinds that are absent are left out (no "0 motions")
     handles = [Line2D([], [], color=c, lw=1.2, label=f"gyro {'xyz'[j]}") for j, c in enumerate(COLOURS[:3])]
     handles += [Patch(**st) for k, st in _SPAN_STYLE.items() if count[k]]
     lg.legend(handles=handles, loc="upper center", ncol=len(handles), fontsize=9, frameon=False,

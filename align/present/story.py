@@ -15,7 +15,8 @@ make_report, Outcome, build_report, demo_inputs, run_demo, DEMO_TITLE, DEMO, PAR
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+import dataclasses
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -118,9 +119,11 @@ def make_report(mount: Path | None = None, manoeuvre: Path | None = None, log: P
                 allan_rate_hz: float | None = None, allan_units: str = "deg/s", gyro_units: str = "deg/s",
                 table_rate: str = "100 deg/s", accuracy: str = "0.1 deg", noise_ratio: float = 10.0,
                 monte_carlo: int = 100_000, seed: int = 0, basis: str = "rss", progress=None,
-                title: str = "IMU alignment report", source: Callable[[Path], Path] | None = None,
+                title: str | None = None, source: Callable[[Path], Path] | None = None,
                 log_format: LogFormat | None = None, alignment: Path | None = None, calibrations: Sequence[Path] = (),
-                drift: Sequence[Path] = (), header: dict | None = None, parts: dict | None = None) -> Outcome:
+                drift: Sequence[Path] = (), header: dict | None = None, parts: Mapping | None = None,
+                log_columns: str | None = None, log_rate_hz: float | None = None,
+                spell: Callable[[str, str | None], str] | None = None) -> Outcome:
     """Run every job whose inputs are given, from any subset of them, and build the report.
 
     Parameters
@@ -129,6 +132,9 @@ def make_report(mount: Path | None = None, manoeuvre: Path | None = None, log: P
         Mount and manoeuvre TOML: the budget (Eq 1-4, Monte Carlo) and what the manoeuvre allows.
     log, plan : Path, optional
         A rate-table log and its plan, aligned here (both or neither); or ``alignment``, an alignment result file.
+    log_columns, log_rate_hz : str, float, optional
+        The log's columns (``time,x,y,z``; ``x,y,z`` with ``log_rate_hz``, Hz, for a log without time); None: a
+        log's ``time,gyro_x,gyro_y,gyro_z``, and for an alignment result file what it recorded.
     allan : Path, optional
         A static record (``allan_columns``, ``allan_rate_hz``, ``allan_units``) or an Allan result file (``.json``);
         a gyro's gives the test plan for ``table_rate``, ``accuracy``, ``noise_ratio``.
@@ -138,18 +144,28 @@ def make_report(mount: Path | None = None, manoeuvre: Path | None = None, log: P
         Navigation results whose error growth is shown (:mod:`align.present.navigation`).
     parts : dict of str to Part, optional
         The presets the mount's part is looked up in (:func:`align.parts.merge_parts`); the built-in table when None.
+    title : str, optional
+        The report's title; default by what is reported: ``IMU alignment report`` (a mount, manoeuvre or
+        alignment), ``IMU calibration report`` (calibrations), ``IMU noise report`` (an Allan record alone),
+        ``IMU report`` otherwise.
     header : dict, optional
         The report's identification (``"serial number"``, ``"operator"``, ``"test"``, ``"date"``), shown under
         the title with the tool's version.
     source : callable, optional
         Maps an input's path (as shown) to the file to read (the demo reads its staged inputs).
     log_format : LogFormat, optional
-        A logger file's preamble, comments, delimiter, time unit: for the rate-table log and the static record.
+        A logger file's preamble, comments, delimiter, time unit: for the rate-table log and the static record;
+        None: a plain CSV, and for an alignment result file the format it recorded.
+    spell : callable, optional
+        ``spell(field, value_or_None) -> str``: how the terminal summary names an input in a note (the command
+        line's flags); plain words when None.
 
     Returns
     -------
     Outcome
         The summary (every check, its verdict and its number) comes first on the page, the inputs last.
+        The measured misalignment, when checked, governs the outcome: the mounting budget against the
+        allowance is then a design check, shown with its verdict but failing nothing.
 
     Raises
     ------
@@ -174,7 +190,7 @@ def make_report(mount: Path | None = None, manoeuvre: Path | None = None, log: P
         b, m = jobs.mount_job(rep, mount, monte_carlo, seed, progress, parts)
     allow = jobs.manoeuvre_job(rep, manoeuvre, b, m, basis, monte_carlo)
     if log is not None or alignment is not None:
-        jobs.alignment_job(rep, allow, log, plan, alignment, gyro_units, log_format)
+        jobs.alignment_job(rep, allow, log, plan, alignment, gyro_units, log_format, log_columns, log_rate_hz)
     elif allow is not None and b is None:
         rep.verdicts.append(Verdict("allowance", INFO, f"binding {allow.binding} = {allow.binding_value / DEG:.4f} deg",
                                     allow.binding_value / DEG, "no budget or alignment given to check against it"))
@@ -184,17 +200,62 @@ def make_report(mount: Path | None = None, manoeuvre: Path | None = None, log: P
         jobs.calibration_job(rep, path)
     for path in drift:  # issue 16: the error growth of a navigation result
         jobs.drift_job(rep, path)
+    if rep.measured:  # the unit is measured: the budget is a design check and governs nothing
+        rep.verdicts = [dataclasses.replace(v, governs=False) if v.design else v for v in rep.verdicts]
     sections = [summary_section(rep.verdicts)]
     sections += [s for part in PARTS for s in rep.sections.get(part, [])]
     sections.append(report.inputs_section(rep.inputs))
-    failed = [v for v in rep.verdicts if v.failed]
+    text = "\n".join([_say(x, spell) for x in rep.lines] + [f"summary: {_verdict(rep.verdicts)}"])
+    if title is None:
+        title = ("IMU alignment report" if any(x is not None for x in (mount, manoeuvre, log, alignment)) else
+                 "IMU calibration report" if calibrations else "IMU noise report" if allan is not None and not drift
+                 else "IMU report")
+    return Outcome(report.html_report(title, sections, header, _conventions(rep.results)), text, rep.results,
+                   tuple(rep.verdicts), tuple(rep.measured))
+
+
+def _conventions(results: dict) -> list[str]:
+    """The matrix conventions of the results shown (a gyro alignment's, a calibration's, a magnetometer's), once each."""
+    from align import CONVENTION
+
+    out: list[str] = []
+    for r in results.values():
+        c = getattr(type(r), "CONVENTION", "")
+        c = CONVENTION if c.startswith(CONVENTION) else c
+        if c.startswith(("g = M", "raw = M", "m_cal =")) and c not in out:
+            out.append(c)
+    return out
+
+
+def _say(line, spell) -> str:
+    """A terminal line; a note's placeholders in the caller's spelling (plain words by default)."""
+    from align.errors import AlignError
+    from align.present.reread import Said, in_words
+
+    if not isinstance(line, Said):
+        return line
+    return in_words(line.template) if spell is None else AlignError(line.template).render(spell)
+
+
+def _verdict(verdicts) -> str:
+    """The terminal's last line: FAIL (the failed checks), WARN (the cautions), PASS, or no requirement checked;
+    and a failed design check that governs nothing."""
+    from align.present.verdicts import FAIL, PASS, WARN
+
+    governing = [v for v in verdicts if v.governs]
+    failed = [v for v in governing if v.status == FAIL]
+    warned = [v for v in governing if v.status == WARN]
     if failed:
-        verdict = "FAIL (" + "; ".join(f"{v.check}: {v.number}" for v in failed) + ")"
+        out = "FAIL (" + "; ".join(f"{v.check}: {v.number}" for v in failed) + ")"
+    elif warned:
+        out = "WARN (" + "; ".join(f"{v.check}: {v.number}" for v in warned) + ")"
     else:
-        verdict = "PASS" if any(v.status == "PASS" for v in rep.verdicts) else "no requirement checked"
-    text = "\n".join(rep.lines + [f"summary: {verdict}"])
-    return Outcome(report.html_report(title, sections, header), text, rep.results, tuple(rep.verdicts),
-                   tuple(rep.measured))
+        out = "PASS" if any(v.status == PASS for v in governing) else "no requirement checked"
+    design = [v for v in verdicts if not v.governs and v.status == FAIL]
+    if design:
+        out += "; design check " + ", ".join(f"{v.check} FAIL ({v.number})" for v in design) + \
+            ": the measured unit governs"
+    return out
 
 
 def build_report(mount: Path | None = None, manoeuvre: Path | None = None, **kwargs) -> tuple[str, str, dict]:

@@ -19,7 +19,7 @@ import numpy as np
 
 from align.alignment.result import AlignmentResult
 from align.io.export import matrix_unit
-from align.model import Angles, angles
+from align.present.angles import AngleRow, angle_rows, number
 from align.present.presets import preset_lines
 from align.units import DEG, to_unit
 
@@ -46,36 +46,31 @@ def _assumed_gyro(r: AlignmentResult) -> int | None:
     return None if r.inferred_axis is None else int(np.argmax(np.abs(r.mounting[:, r.inferred_axis])))
 
 
-def angle_lines(ang: Angles, assumed: int | None = None, indent: str = "  ") -> list[str]:
-    """Scale factors and the misalignment angles in degrees (reference section 1), as ``matrix`` prints them.
+def angle_lines(rows: list[AngleRow], indent: str = "  ") -> list[str]:
+    """Scale factors and the misalignment angles in degrees (reference section 1), one line per row of
+    :func:`align.present.angles.angle_rows` (the one layout every output uses), with the 1-sigma when known.
 
-    Parameters
-    ----------
-    ang : Angles
-        From :func:`align.model.angles` of ``M`` (rows are sensor axes).
-    assumed : int, optional
-        The axis whose scale was assumed, not measured (marked).
+    The scale line ends with M's unit when M is not dimensionless (``(counts per m/s^2)``).
     """
-    return [indent + "scale factors      " + "  ".join(f"{s:.6f}" + ("(assumed)" if i == assumed else "")
-                                                   for i, s in enumerate(ang.scale)),
-            indent + "psi (axis-frame)   " + "  ".join(f"{k}={v / DEG:.4f}" for k, v in zip("xyz", ang.psi)),
-            indent + "phi (cross-axis)   " + "  ".join(f"{'xyz'[i]}{'xyz'[j]}={ang.phi[i, j] / DEG:+.4f}"
-                                                     for i in range(3) for j in range(3) if i != j),
-            indent + "delta (axis-axis)  " + "  ".join(f"{p}={v / DEG:+.4f}" for p, v in zip(("xy", "xz", "yz"), ang.delta)),
-            indent + "mounting rotation  " + ", ".join(f"{v / DEG:+.4f}" for v in ang.mounting_rotvec) + " (rotation vector)"]
+    out = []
+    for r in rows:
+        tail = {"rotation": "  (rotation vector)"}.get(r.key, "")
+        if r.key == "scale" and r.unit != "1":
+            tail = f"  ({r.unit})"
+        out.append(f"{indent}{r.label:<19}" + "  ".join(r.text()) + tail)
+    return out
 
 
 def alignment_summary(r: AlignmentResult) -> str:
     """The summary ``imu-align matrix`` prints: M, A, bias, angles, segments, checks."""
     u = r.units
-    ang = r.angles
     out = [f"Electronic alignment ({r.method}), convention g = M w + b, w = A (g - b)", "",
            "M (1-sigma):", matrix_text(r.M, r.sigma_M), "",
            "A = M^-1 (1-sigma):", matrix_text(r.A, r.sigma_A), "",
            "bias [" + u + "]: " + ", ".join(f"{b:+.5g} ± {s:.2g}" for b, s in zip(to_unit(r.bias, u), to_unit(r.sigma_bias, u))),
            "",
            "angles [deg]" + ("" if np.allclose(r.mounting, np.eye(3)) else ", relative to the nominal mounting") + ":",
-           *angle_lines(ang, _assumed_gyro(r)),
+           *angle_lines(angle_rows(r.M, r.sigma_M, r.mounting, assumed=_assumed_gyro(r))),
            "",
            f"design condition number {r.condition_number:.3g}, {r.dof} degrees of freedom per gyro",
            "", "segments (residual / noise, per gyro):"]
@@ -310,11 +305,15 @@ def calibration_summary(cals: dict) -> str:
         if "g_sensitivity" in d:
             out.append(f"  g-sensitivity [{d['units']['g_sensitivity']}]:")
             out.append(matrix_text(np.array(d["g_sensitivity"]), None, 6, "    "))
-        out += ["  angles of M's rows (sensor axes) in the calibration frame [deg]:", *angle_lines(angles(c.M), None, "    ")]
+        out += ["  angles of M's rows (sensor axes) in the calibration frame [deg]:",
+                *angle_lines(angle_rows(c.M, c.sigma_M, unit=matrix_unit(c.units, c.sensor)), "    ")]
         if d["residuals"]:
             worst = max(d["residuals"].items(), key=lambda kv: float(np.max(np.abs(kv[1]))))
-            what = "rotations" if all(k.startswith("rotation ") for k in d["residuals"]) else "positions"
-            out.append(f"  largest residual: {worst[0]} {np.max(np.abs(worst[1])):.3g} {u} ({len(d['residuals'])} {what})")
+            n = len(d["residuals"])
+            what = f"{n} rotations" if all(k.startswith("rotation ") for k in d["residuals"]) else f"{n} positions"
+            if c.sensor == "gyroscope" and "turn" in c.method.lower() and not what.endswith("rotations"):
+                what = f"the {n} static faces, where the bias is fitted; M is fitted from the turns"
+            out.append(f"  largest residual: {worst[0]} {np.max(np.abs(worst[1])):.3g} {u} ({what})")
         for k, v in d["checks"].items():
             out.append(f"  held-out check {k}: residual {np.max(np.abs(v)):.3g} {u}")
         out += [f"  note: {n}" for n in d["notes"]] + [""]
@@ -327,13 +326,12 @@ def magnetometer_summary(c) -> str:
     rows the magnetometer axes), as ``matrix`` prints them."""
     d = c.to_dict()
     u, q = d["units"]["hard_iron"], d["quality"]
-    whole = c.soft_iron if c.misalignment is None else c.misalignment @ c.soft_iron
     frame = {"axis-down": " in the body (fixture) frame, from the axis-down turns",
              "gravity": " in the accelerometer frame"}.get(c.misalignment_method, " in the body frame")
     rot = d.get("misalignment_angles")
     rot_lines = [] if rot is None else [
         "  misalignment rotation (alpha, beta, gamma about x, y, z) [deg]: "
-        + ", ".join(f"{a:+.3f}" + ("" if s is None else f" ± {s:.3f}")
+        + ", ".join(number(a, 3) + ("" if s is None else f" ± {s:.3f}")
                     for a, s in zip(rot["angles_deg"], rot["sigma_deg"] or [None] * 3))
         + ("" if rot["sigma_deg"] is None else " (1 sigma)")]
     lines = [f"magnetometer ({d['model']} soft iron), convention {d['convention']}",
@@ -347,7 +345,7 @@ def magnetometer_summary(c) -> str:
              "  angles of M = (" + ("misalignment " if c.misalignment is not None else "")
              + "soft_iron)^-1, rows the magnetometer axes"
              + (frame if c.misalignment is not None else "") + " [deg]:",
-             *angle_lines(angles(np.linalg.inv(whole)), None, "    "),
+             *angle_lines(angle_rows(c.model_matrix), "    "),
              f"  field {d['field']:.5g} {u}; field-magnitude spread {100 * q['field_spread_before']:.2f} % before, "
              f"{100 * q['field_spread_after']:.2f} % after; direction coverage {q['coverage']:.3f} (full sphere 0.333)",
              f"  predicted heading error {q['predicted_heading_error_deg']:.2f} deg (1 sigma)"]

@@ -1,14 +1,16 @@
 """The report's verdicts: each check with its outcome and the one number behind it, and the measured
 misalignment against what the manoeuvre allows, element by element.
 
-A :class:`Verdict` is one line of the summary at the top of the report (``PASS``, ``FAIL``, or ``INFO``
-for a result that has no requirement to meet); :func:`measured_margins` sets an alignment result's
-angles (with their 1-sigma, :func:`angle_sigmas`) against an :class:`~align.sensitivity.allowable.Allowable`.
+A :class:`Verdict` is one line of the summary at the top of the report (``PASS``, ``FAIL``, ``WARN``
+for a result within its guard band of a limit or a caution, or ``INFO`` for a result that has no requirement
+to meet). A design check (the mounting budget against the allowance) governs the report's outcome only
+when no measured misalignment is checked: the measured unit governs, and the budget's outcome is shown
+labelled as a design check. :func:`angle_sigmas` gives the 1-sigma of every angle of reference section 1;
+the measured misalignment against the manoeuvre is :mod:`align.present.measured`.
 
 Public names
 ------------
-Verdict, MeasuredMargin, angle_vector, angle_sigmas, measured_margins, summary_section, measured_section,
-PASS, FAIL, WARN, INFO
+Verdict, angle_vector, angle_sigmas, summary_section, worst, ANGLE_NAMES, PASS, FAIL, WARN, INFO
 """
 
 from __future__ import annotations
@@ -18,8 +20,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from align.present.html import Section, esc, table
-from align.sensitivity.symbolic import ELEMENTS
-from align.units import DEG
 
 PASS, FAIL, WARN, INFO = "PASS", "FAIL", "WARN", "INFO"
 #: the angles :func:`angle_vector` returns, in order
@@ -43,6 +43,10 @@ class Verdict:
         That number, in the unit shown (for tests and machine readers; NaN when there is none).
     detail : str
         One line: which element, against what.
+    design : bool
+        A design-stage check (the mounting budget against the allowance), not a measurement of the unit.
+    governs : bool
+        Whether a FAIL fails the report (False for a design check when a measurement is checked too).
     """
 
     check: str
@@ -50,39 +54,19 @@ class Verdict:
     number: str
     value: float = float("nan")
     detail: str = ""
+    design: bool = False
+    governs: bool = True
 
     @property
     def failed(self) -> bool:
-        return self.status == FAIL
-
-
-@dataclass(frozen=True)
-class MeasuredMargin:
-    """One element of the measured misalignment against the allowance (angles in rad).
-
-    ``measured`` is signed (``phi_ij``); the check compares ``|measured|`` with ``allowed`` (``inf``:
-    unconstrained); ``margin = allowed - |measured|``.
-    """
-
-    element: str
-    measured: float
-    sigma: float
-    allowed: float
+        """A FAIL that fails the report (a design check's FAIL does not when a measurement governs)."""
+        return self.status == FAIL and self.governs
 
     @property
-    def margin(self) -> float:
-        return self.allowed - abs(self.measured)
-
-    @property
-    def ok(self) -> bool:
-        return abs(self.measured) <= self.allowed
-
-    @property
-    def sigmas(self) -> float:
-        """The margin in units of the measurement's 1-sigma (NaN when unconstrained or sigma unknown)."""
-        if not np.isfinite(self.allowed) or not self.sigma > 0:
-            return float("nan")
-        return self.margin / self.sigma
+    def shown(self) -> str:
+        """The status as the summary shows it: ``FAIL (design check)`` when it does not govern."""
+        return f"{self.status} (design check)" if self.design and not self.governs and self.status != INFO \
+            else self.status
 
 
 def angle_vector(m: np.ndarray) -> np.ndarray:
@@ -138,29 +122,6 @@ def angle_sigmas(m: np.ndarray, sigma_m: np.ndarray, mounting: np.ndarray | None
     return dict(zip(ANGLE_NAMES, np.sqrt(var).tolist()))
 
 
-def measured_margins(result, allow) -> list[MeasuredMargin]:
-    """An alignment result's misalignment against a manoeuvre's allowance, element by element.
-
-    Parameters
-    ----------
-    result : AlignmentResult
-        Its angles are those of ``M N^T`` (relative to the nominal mounting).
-    allow : Allowable
-        Allowance per element, rad (``inf``: unconstrained).
-
-    Returns
-    -------
-    list of MeasuredMargin
-        In :data:`~align.sensitivity.symbolic.ELEMENTS` order; ``psi_i`` and ``phi_ij`` from
-        :attr:`AlignmentResult.angles`, the 1-sigma from :func:`angle_sigmas`.
-    """
-    ang = result.angles
-    sig = angle_sigmas(result.M, result.sigma_M, result.mounting)
-    value = {f"psi_{a}": float(ang.psi[i]) for i, a in enumerate("xyz")}
-    value.update({f"phi_{a}{b}": float(ang.phi[i, j]) for i, a in enumerate("xyz") for j, b in enumerate("xyz") if i != j})
-    return [MeasuredMargin(e, value[e], sig[e], float(allow.allowable[e])) for e in ELEMENTS]
-
-
 def worst(rows: list) -> object:
     """The row of smallest margin (the binding one), constrained rows first."""
     bounded = [r for r in rows if np.isfinite(r.allowed)]
@@ -175,36 +136,28 @@ def summary_section(verdicts: list[Verdict]) -> Section:
     """The summary: the overall outcome in one line, then each check, its verdict, its number and what it means."""
     if not verdicts:
         return Section("Summary", "<p>No check: no input was given that a requirement applies to.</p>")
-    failed = [v for v in verdicts if v.failed]
-    checked = [v for v in verdicts if v.status in (PASS, FAIL)]
+    governing = [v for v in verdicts if v.governs]
+    failed = [v for v in governing if v.status == FAIL]
+    warned = [v for v in governing if v.status == WARN]
+    checked = [v for v in governing if v.status in (PASS, FAIL, WARN)]
+    n = f"{len(checked)} check{'s' if len(checked) != 1 else ''}"
+    cautions = "" if not warned else (f" {len(warned)} WARN ({esc(', '.join(v.check for v in warned))}): within the "
+                                      "guard band of a limit, or a caution.")
     if failed:
-        head = (f'<p class="banner fail">FAIL: {len(failed)} of {len(checked)} check{"s" if len(checked) != 1 else ""} '
-                f"failed ({esc(', '.join(v.check for v in failed))}).</p>")
+        head = (f'<p class="banner fail">FAIL: {len(failed)} of {n} failed ({esc(", ".join(v.check for v in failed))}).'
+                f"{cautions}</p>")
+    elif warned:
+        head = f'<p class="banner warn">WARN: none of {n} failed;{cautions}</p>'
     elif checked:
         head = ('<p class="banner pass">PASS: ' + ("the one check passed" if len(checked) == 1
                                                    else f"all {len(checked)} checks passed") + ".</p>")
     else:
         head = '<p class="banner info">No requirement was given: the results below are reported without a verdict.</p>'
-    rows = [[v.check, (v.status, _cls(v.status)), v.number, v.detail] for v in verdicts]
+    design = [v for v in verdicts if not v.governs and v.status in (FAIL, WARN)]
+    if design:
+        head += (f'<p class="note">Design check{"s" if len(design) > 1 else ""} '
+                 f"{esc(', '.join(v.check for v in design))}: {esc(', '.join(v.status for v in design))}. A design check "
+                 "(what the mounting is predicted to give) does not set this report's outcome when the unit's "
+                 "misalignment is measured: the measurement governs.</p>")
+    rows = [[v.check, (v.shown, _cls(v.status)), v.number, v.detail] for v in verdicts]
     return Section("Summary", head + table(["check", "verdict", "number", "what it means"], rows, left=4))
-
-
-def measured_section(rows: list[MeasuredMargin], note: str = "") -> Section:
-    """The measured misalignment (with its 1-sigma) against the allowance, element by element."""
-    out = []
-    for r in rows:
-        bounded = np.isfinite(r.allowed)
-        sign = "+" if r.element.startswith("phi") else ""  # phi_ij is signed, psi_i an angle from the axis
-        out.append([r.element, f"{r.measured / DEG:{sign}.4f}", "-" if not np.isfinite(r.sigma) else f"{r.sigma / DEG:.4f}",
-                    f"{r.allowed / DEG:.4f}" if bounded else "unconstrained",
-                    f"{r.margin / DEG:+.4f}" if bounded else "-",
-                    "-" if not np.isfinite(r.sigmas) else f"{r.sigmas:+.1f}",
-                    ("PASS", "pass") if r.ok else ("FAIL", "fail")])
-    ok = all(r.ok for r in rows)
-    body = (f"<p>Measured misalignment against the allowance: <b class=\"{'pass' if ok else 'fail'}\">"
-            f"{'PASS' if ok else 'FAIL'}</b>. |measured| is compared with the allowed angle; margin = allowed - "
-            "|measured|.</p>"
-            + table(["element", "measured [deg]", "1-sigma [deg]", "allowed [deg]", "margin [deg]", "margin / sigma",
-                     "result"], out)
-            + (f'<p class="note">{esc(note)}</p>' if note else ""))
-    return Section("Measured misalignment against the allowance", body)

@@ -335,6 +335,6 @@ def test_imucal_export_loads_with_imucals_own_loader(results, tmp_path):
 
 def test_export_prints_when_no_out_is_given_and_names_what_it_wrote(results, tmp_path):
     text = _export(results / "allan.json", "--to", "csv")
-    assert text.startswith("# imu-align.allan")
+    assert text.startswith("# Allan deviation curve from allan.json (imu-align.allan); written by imu-align ")
     code, out, _ = _cli("export", results / "allan.json", "--to", "csv", "--out", tmp_path / "a.csv")
     assert code == 0 and out.startswith(f"wrote {tmp_path / 'a.csv'}") and (tmp_path / "a.csv").read_text() == text

@@ -29,7 +29,7 @@ def _printed_angles(block: str) -> dict[str, float]:
     for key, line in (("psi", "psi (axis-frame)"), ("phi", "phi (cross-axis)"), ("delta", "delta (axis-axis)")):
         text = next(t for t in block.splitlines() if line in t)
         found |= {f"{key}_{k}": float(v) for k, v in re.findall(r"([xyz]{1,2})=([+-]?[0-9.]+)", text)}
-    text = next(t for t in block.splitlines() if "scale factors" in t)
+    text = re.sub(r" ± \S+|\(assumed\)|\([a-z/^ 0-9]+\)", "", next(t for t in block.splitlines() if "scale factors" in t))
     found |= {f"scale_{i}": float(v) for i, v in enumerate(text.split()[2:5])}
     return found
 

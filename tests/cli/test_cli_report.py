@@ -88,7 +88,7 @@ def test_report_of_a_rate_table_log_alone_renders(tmp_path, run_cli):
     assert "Mounting-misalignment budget" not in sections(page)  # no mount given: no budget
     for text in ("SN 0042", "A. Tester", "WO-7", "Acceptance of SN 0042", "imu-align 0.", "<td>date</td>"):
         assert text in page
-    assert "phi_ij" in page and "mounting rotation" in page and "delta_xy" in page
+    assert "phi (cross-axis)" in page and "mounting rotation" in page and "delta_ij = asin(u_i . u_j)" in page
     assert len(pictures(page)) == 1  # the segmentation of the log
     from PIL import Image
 
@@ -130,24 +130,30 @@ def test_measured_misalignment_over_the_allowance_fails_at_the_top_and_exits_4(t
     out = tmp_path / "report.html"
     res = run_cli("report", "--log", log, "--plan", plan, "--manoeuvre", man, "--out", out)
     assert res.code == 4 and out.exists()  # written, then the failure is the exit status (as check)
-    assert "measured misalignment vs allowance" in res.err and "phi_xz" in res.err
+    assert "measured misalignment vs allowance" in res.err and "output x" in res.err
     page = out.read_text()
     assert sections(page)[:2] == ["Summary", "Measured misalignment against the allowance"]
     summary = page.split("<h2>Summary</h2>")[1].split("<h2>")[0]
     assert summary.startswith('<p class="banner fail">FAIL: 1 of 2 checks failed (measured misalignment vs allowance)')
-    # the number behind it: phi_xz of the alignment result (matrix --json) against asin((1/6 deg) / 30 deg)
+    # the number behind it: one turn of 30 deg about z gives the x gyro sin(phi_xz) 30 deg (Eq 11-13 for a fixed axis,
+    # exact), phi_xz the alignment result's (matrix --json), against the 1/6 deg limit
     d = json.loads(align_json.read_text())
     phi = d["angles"]["phi_deg"]["phi_xz"]
     assert abs(phi - 0.42) < 0.01  # the simulation's truth, to first order
+    error = np.sin(np.radians(phi)) * 30
+    shown = float(re.search(r"output x margin ([-+0-9.]+) deg", summary).group(1))
+    assert shown == pytest.approx(0.1667 - error, abs=1e-4)
+    assert f"error {error:.4f} ±" in summary and "against the 0.1667 deg limit" in summary
+    assert "guard band 2 sigma" in summary and "Guard band k = 2" in page
+    assert f"summary: FAIL (measured misalignment vs allowance: output x margin {shown:+.4f} deg)" in res.out
+    # the diagnosis: phi_xz alone over its allowance asin((1/6 deg) / 30 deg)
     allowed = np.degrees(np.arcsin(0.1667 / 30))
-    assert f"phi_xz margin {allowed - abs(phi):+.4f} deg" in summary
-    assert f"measured {phi:+.4f}" in summary and f"against {allowed:.4f} deg allowed" in summary
-    assert f"summary: FAIL (measured misalignment vs allowance: phi_xz margin {allowed - abs(phi):+.4f} deg)" in res.out
+    assert f"<td class=\"l\">phi_xz</td><td class=\"\">{phi:+.4f}</td>" in page and f"{allowed:.4f}" in page
     # the same from the result file, without the log: same numbers, same verdict, the log drawn again from its path
     again = tmp_path / "again.html"
     res2 = run_cli("report", "--alignment", align_json, "--manoeuvre", man, "--out", again)
     assert res2.code == 4
-    assert f"phi_xz margin {allowed - abs(phi):+.4f} deg" in again.read_text()
+    assert f"output x margin {shown:+.4f} deg" in again.read_text()
     assert len(pictures(again.read_text())) == 1
 
 
@@ -174,7 +180,7 @@ def test_budget_and_noise_numbers_are_the_underlying_results(tmp_path, run_cli):
     n = {k: f["ieee_point_readouts"]["N_at_tau_1s"] for k, f in fit.items()}
     k = max(n, key=n.get)
     assert f"{n[k]:.4g} deg/sqrt(h) ({k})" in page
-    assert "bias repeatability" in page and "not measured" in page and "bias stability, 10 s averages" in page
+    assert "bias repeatability" in page and "not measured" in page and "bias stability: std of the 10 s means" in page
     assert "Example 1" not in res.out and "source total 1.3043 deg" in res.out  # the budget's own figure, no aside
 
 

@@ -189,3 +189,32 @@ def test_read_runs_needs_one_sample_rate(tmp_path):
     with pytest.raises(InputError, match="differs from the first run's") as err:
         read_runs([tmp_path / "a.csv", tmp_path / "c.csv"], ["gx"])
     assert "c.csv" in str(err.value)
+
+
+def test_an_unidentified_random_walk_is_stated_as_its_upper_bound_in_json_and_kalibr(tmp_path):
+    """One number for a random walk a short record cannot identify: the JSON's Kalibr-style block and the Kalibr
+    export both give the fit's 95 % upper bound, and say so (not the fit's 0)."""
+    import yaml
+
+    from align.cli import run
+    from align.noise.sim import NoiseSpec, simulate_noise
+    from align.units import parse_quantity, to_unit
+
+    fs = 100.0
+    x = simulate_noise(int(0.03 * 3600 * fs), fs, NoiseSpec(white=parse_quantity("0.3 deg/sqrt(h)", "angle_random_walk")), 3, seed=4)
+    np.save(tmp_path / "s.npy", to_unit(x, "deg/s"))
+    out, yml = tmp_path / "a.json", tmp_path / "imu.yaml"
+    assert run(["allan", str(tmp_path / "s.npy"), "--rate-hz", "100", "--json", str(out)]) == 0
+    d = json.loads(out.read_text())
+    fits = d["fit"] if isinstance(d["fit"], list) else list(d["fit"].values())
+    bounds = []
+    for fit in fits:
+        rw = fit["terms"]["rate_random_walk"]
+        assert not rw["identifiable"] and rw["upper_bound"] > 0
+        c = fit["continuous"]
+        assert c["gyroscope_random_walk_is"].startswith("95 % upper bound")
+        si = parse_quantity(f"{rw['upper_bound']} {rw['unit']}", "rate_random_walk")
+        assert c["gyroscope_random_walk"] == pytest.approx(si, rel=1e-9)
+        bounds.append(c["gyroscope_random_walk"])
+    assert run(["export", str(out), "--to", "kalibr", "--out", str(yml)]) == 0
+    assert yaml.safe_load(yml.read_text())["gyroscope_random_walk"] == pytest.approx(max(bounds), rel=1e-6)

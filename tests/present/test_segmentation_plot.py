@@ -152,7 +152,7 @@ def test_the_picture_shades_one_span_per_segment_and_motion(monkeypatch):
     for label, kind in by_label.items():
         want = sorted((s.t_start, s.t_end) for s in r.segments if s.kind == kind)
         assert np.allclose(drawn[label], want)
-    assert np.allclose(drawn["motion no step claimed (ignored)"], [(t[a], t[b - 1])])
+    assert np.allclose(drawn["motion that no step claimed (ignored)"], [(t[a], t[b - 1])])
     assert len(drawn["ramp (moving, not used)"]) == sum(s.kind == "ramp" for s in spans)
 
 

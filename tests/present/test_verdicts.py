@@ -6,6 +6,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from align.model import SensorModel
+from align.present.measured import measured_margins
 from align.present.verdicts import (
     ANGLE_NAMES,
     FAIL,
@@ -15,7 +16,6 @@ from align.present.verdicts import (
     Verdict,
     angle_sigmas,
     angle_vector,
-    measured_margins,
     summary_section,
 )
 from align.units import DEG
@@ -81,8 +81,21 @@ def test_measured_margins_against_truth_and_the_allowance_formula(seed):
 def test_summary_banner_and_statuses():
     fail = Verdict("a", FAIL, "x margin -0.1 deg", -0.1)
     page = summary_section([Verdict("b", PASS, "1"), fail, Verdict("c", WARN, "2"), Verdict("d", INFO, "3")]).body
-    assert page.index("FAIL: 1 of 2 checks failed (a)") < page.index("<table")
+    assert page.index("FAIL: 1 of 3 checks failed (a).") < page.index("<table")
+    assert "1 WARN (c)" in page
     assert 'class="l fail">FAIL' in page and 'class="l warn">WARN' in page
     assert "PASS: the one check passed" in summary_section([Verdict("b", PASS, "1")]).body
     assert "without a verdict" in summary_section([Verdict("d", INFO, "3")]).body
     assert fail.failed and not Verdict("c", WARN, "2").failed
+    # a report whose only checks are WARN says so (not "no requirement was given")
+    warn_only = summary_section([Verdict("c", WARN, "2"), Verdict("d", INFO, "3")]).body
+    assert warn_only.startswith('<p class="banner warn">WARN: none of 1 check failed; 1 WARN (c)')
+
+
+def test_a_design_check_does_not_govern_when_the_unit_is_measured():
+    design = Verdict("mounting budget (rss) vs allowance", FAIL, "psi_x margin -0.1 deg", -0.1, design=True,
+                     governs=False)
+    page = summary_section([design, Verdict("measured misalignment vs allowance", PASS, "x margin +0.01 deg")]).body
+    assert page.startswith('<p class="banner pass">PASS: the one check passed.</p>')
+    assert "FAIL (design check)" in page and "the measurement governs" in page
+    assert not design.failed and Verdict("b", FAIL, "1", design=True).failed  # alone, a design check governs
