@@ -41,6 +41,9 @@ with ``x = 2 pi f_k t``::
 
 A residual scale or misalignment error of a static sensor acts as a bias: the accelerometers'
 ``dM`` times gravity (``g sigma_M,iz``), the gyros' ``dM`` times the Earth rate (when included).
+A rigid mounting rotation of the whole IMU (``ResidualErrors.mount``, 1-sigma ``s`` about body x,
+y, z) is an initial attitude error ``eps = C s``: constant angles (S1 = 1), velocity ``g eps t``
+(S2 = t) and position ``g eps t^2 / 2`` (S3 = t^2 / 2) through E2-E3, as a gyro term.
 
 Public names
 ------------
@@ -60,12 +63,14 @@ QUANTITIES = ("roll", "pitch", "heading", "north velocity", "east velocity", "do
 SYNTHESIS_SPAN = 8
 
 
-def flicker_lines(duration: float, points: int) -> tuple[np.ndarray, np.ndarray]:
+def flicker_lines(duration: float, points: int, span: int = SYNTHESIS_SPAN) -> tuple[np.ndarray, np.ndarray]:
     """Frequencies (Hz) and variances per unit ``B^2`` of the flicker synthesis of a mission (E4).
 
     The Monte Carlo synthesises flicker on a grid of ``points - 1`` intervals over the mission,
-    ``SYNTHESIS_SPAN`` times as long (:func:`align.flicker.flicker_fft`'s spectrum: one-sided PSD
-    ``B^2 / (pi f)``, lines ``k df``, ``df = 1 / (SPAN T)``) and keeps its first ``T``.
+    ``span`` times as long (:func:`align.flicker.flicker_fft`'s spectrum: one-sided PSD
+    ``B^2 / (pi f)``, lines ``k df``, ``df = 1 / (span T)``) and keeps its first ``T``. The lowest
+    frequency ``1 / (span T)`` is the model's cutoff: flicker slower than that is left out (the
+    variance of a flicker integral grows as ``ln(span)``).
 
     Returns
     -------
@@ -73,8 +78,8 @@ def flicker_lines(duration: float, points: int) -> tuple[np.ndarray, np.ndarray]
     c2 : ndarray, shape (L,)
         ``df / (pi f)``, the Nyquist line halved.
     """
-    n = SYNTHESIS_SPAN * (points - 1)
-    df = 1.0 / (SYNTHESIS_SPAN * duration)
+    n = span * (points - 1)
+    df = 1.0 / (span * duration)
     f = np.arange(1, n // 2 + 1) * df
     c2 = df / (np.pi * f)
     c2[-1] *= 0.5  # the Nyquist line is real: its cosine only, twice the amplitude (flicker_fft)
@@ -97,17 +102,22 @@ def _flicker_s(t: np.ndarray, lines: tuple[np.ndarray, np.ndarray]) -> np.ndarra
     """``S1, S2, S3`` (3, T) of unit flicker (E4)."""
     f, c2 = lines
     w = 2 * np.pi * f[None, :]
-    x = w * t[:, None]
-    one_minus_cos = 2 * np.sin(x / 2) ** 2
-    xs = _x_minus_sin(x)
-    s1 = np.sum(c2 * (2 * np.sin(x / 2)) ** 2 / w**2, axis=1)
-    s2 = np.sum(c2 * (one_minus_cos**2 + xs**2) / w**4, axis=1)
-    s3 = np.sum(c2 * (xs**2 + _half_x2_minus_1_plus_cos(x) ** 2) / w**6, axis=1)
-    return np.sqrt(np.stack([s1, s2, s3]))
+    out = np.empty((3, len(t)))
+    block = max(1, int(2e6 // max(len(f), 1)))  # times at once: bounded memory for long flicker spans
+    for i in range(0, len(t), block):
+        x = w * t[i:i + block, None]
+        one_minus_cos = 2 * np.sin(x / 2) ** 2
+        xs = _x_minus_sin(x)
+        out[0, i:i + block] = np.sum(c2 * 2 * one_minus_cos / w**2, axis=1)
+        out[1, i:i + block] = np.sum(c2 * (one_minus_cos**2 + xs**2) / w**4, axis=1)
+        out[2, i:i + block] = np.sum(c2 * (xs**2 + _half_x2_minus_1_plus_cos(x) ** 2) / w**6, axis=1)
+    return np.sqrt(out)
 
 
 def _s(term: str, t: np.ndarray, lines) -> np.ndarray:
     """``S1, S2, S3`` (3, T) of a unit figure of ``term`` (module table)."""
+    if term == "mount":  # an initial attitude error
+        return np.stack([np.ones_like(t), t, t**2 / 2])
     if term in ("bias", "matrix", "tilt"):
         return np.stack([t, t**2 / 2, t**3 / 6])
     if term == "ramp":
@@ -133,7 +143,7 @@ def _axis_sigma(s: SensorErrors, term: str, g: float, earth_body: np.ndarray) ->
 
 def term_sigmas(errors: ResidualErrors, t: np.ndarray, gravity: float, heading: float = 0.0,
                 earth_body: np.ndarray | None = None, duration: float | None = None,
-                points: int = 257) -> dict[tuple[str, str], np.ndarray]:
+                points: int = 257, span: int = SYNTHESIS_SPAN) -> dict[tuple[str, str], np.ndarray]:
     """The 1-sigma of the nine error components (QUANTITIES) that each error term alone gives (E1-E4).
 
     Parameters
@@ -147,8 +157,8 @@ def term_sigmas(errors: ResidualErrors, t: np.ndarray, gravity: float, heading: 
         Heading of the static body, rad.
     earth_body : ndarray, shape (3,), optional
         The Earth rate in the body frame (rad/s) that a gyro scale or misalignment error multiplies.
-    duration, points : float, int
-        The mission length and the flicker grid of the Monte Carlo (:func:`flicker_lines`).
+    duration, points, span : float, int, int
+        The mission length, the flicker grid and span of the Monte Carlo (:func:`flicker_lines`).
 
     Returns
     -------
@@ -156,18 +166,20 @@ def term_sigmas(errors: ResidualErrors, t: np.ndarray, gravity: float, heading: 
         ``(sensor, term) -> ndarray (T, 9)`` of every non-zero term; rad, m/s, m.
     """
     t = np.asarray(t, float)
-    lines = flicker_lines(duration or float(t[-1]), points)
+    lines = flicker_lines(duration or float(t[-1]), points, span)
     eb = np.zeros(3) if earth_body is None else np.asarray(earth_body, float)
     c2, s2 = np.cos(heading) ** 2, np.sin(heading) ** 2
     out = {}
     for sensor, term in errors.terms():
-        s = errors.gyro if sensor == "gyroscope" else errors.accel
-        sig = _axis_sigma(s, term, gravity, eb)
+        if sensor == "imu":
+            sig = np.asarray(errors.mount, float)
+        else:
+            sig = _axis_sigma(errors.gyro if sensor == "gyroscope" else errors.accel, term, gravity, eb)
         if not np.any(sig > 0):
             continue
         unit = _s(term, t, lines)  # (3, T)
         var = np.zeros((len(t), 9))
-        if sensor == "gyroscope":
+        if sensor != "accelerometer":  # the gyros' and the initial attitude's errors are angles
             a = (sig[:, None, None] * unit[None]) ** 2  # (axis, S_k, T)
             var[:, 0], var[:, 1], var[:, 2] = a[0, 0], a[1, 0], a[2, 0]
             var[:, 3] = gravity**2 * (s2 * a[0, 1] + c2 * a[1, 1])

@@ -15,13 +15,24 @@ from __future__ import annotations
 
 import numpy as np
 
+from align.earth import EARTH_RATE
 from align.errors import InputError
-from align.navigation.closed import QUANTITIES, dominance, dominance_text, static_sigma, term_sigmas
+from align.navigation.closed import (
+    QUANTITIES,
+    SYNTHESIS_SPAN,
+    dominance,
+    dominance_text,
+    static_sigma,
+    term_sigmas,
+)
 from align.navigation.mission import Mission
-from align.navigation.montecarlo import monte_carlo, navigation_step, slow_grid, term_monte_carlo
+from align.navigation.montecarlo import KEEP, NAV_RATE, monte_carlo, navigation_step, slow_grid, term_monte_carlo
 from align.navigation.residuals import ResidualErrors, label
 from align.navigation.result import DriftResult
 from align.units import DEG
+
+#: the largest flicker span (mission lengths) the synthesis takes
+MAX_FLICKER_SPAN = 256
 
 #: runs of each one-term Monte Carlo (at most the main one's)
 TERM_RUNS = 200
@@ -42,8 +53,47 @@ def _agreement_note(sigma: np.ndarray, closed: np.ndarray, runs: int) -> str | N
             "out (the vertical channel's g eps^2 / 2 of a large tilt error, the Earth-rate couplings)")
 
 
+def _rate_note(fs: float, nav_rate: float | None, used: float) -> str | None:
+    """Say where the navigation rate used is not the one asked for (capped at the sample rate, or rounded)."""
+    asked = NAV_RATE if nav_rate is None else float(nav_rate)
+    if asked > fs * (1 + 1e-9):
+        return (f"navigation rate {asked:g} Hz is above the sample rate: navigating at every sample, {used:g} Hz "
+                "(the navigation rate is at most the sample rate)")
+    if abs(used - asked) > 1e-9 * asked:
+        return (f"navigation at {used:g} Hz, not {asked:g} Hz: a step is a whole number of samples "
+                f"({round(fs / used)} at {fs:g} Hz)")
+    return None
+
+
+def _error_notes(mission: Mission, errors: ResidualErrors, span: int) -> list[str]:
+    """What the error model assumes, for the terms present: flicker cutoff, mounting rotation, misalignment."""
+    notes = []
+    if any(np.any(s.flicker > 0) for s in (errors.gyro, errors.accel)):
+        notes.append(f"bias instability: flicker of PSD B^2 / (pi f) from {1 / (span * mission.duration):.3g} Hz "
+                     f"(1 / ({span} T), flicker span {span} mission lengths) up: slower wander is left out (it is the turn-on "
+                     "bias's); the flicker's angle variance grows as ln of that span")
+    if np.any(errors.mount > 0):
+        notes.append("IMU mounting rotation (mount error: attitude): the whole IMU, gyros and accelerometers, turned "
+                     "relative to the vehicle whose attitude starts the navigation: an initial attitude error, drawn "
+                     "per run as a zero-mean Gaussian rotation whose rms axis misalignments are the budget's per-axis "
+                     "RSS (1-sigma per axis in the errors' source); the attitude errors are the IMU's (the vehicle's "
+                     "attitude read from it "
+                     "is off by the same rotation in the body frame); a tilt puts g eps into the horizontal channels "
+                     "from t = 0")
+    if np.any(errors.gyro.tilt > 0):
+        still = mission.kind == "static" and not mission.earth_rate
+        notes.append("gyro mounting misalignment (mount error: turns): the initial attitude aligned in place by the "
+                     "IMU, the budget's per-axis RSS as the gyro axes' rms misalignment relative to that frame (a zero-mean "
+                     "Gaussian lean in a random direction per run): it acts only "
+                     "through the body's turns (and the Earth rate)"
+                     + ("; this static mission without the Earth rate costs nothing from it: give a manoeuvre or a "
+                        "recorded trajectory, or take the mount error as an initial attitude error" if still else ""))
+    return notes
+
+
 def drift(mission: Mission, errors: ResidualErrors, runs: int = 1000, seed: int = 0, nav_rate: float | None = None,
-          points: int = 601, term_runs: int = TERM_RUNS, inputs: dict | None = None, progress=None) -> DriftResult:
+          points: int = 601, term_runs: int = TERM_RUNS, inputs: dict | None = None, progress=None,
+          flicker_span: int = SYNTHESIS_SPAN) -> DriftResult:
     """Attitude, velocity and position error growth of ``mission`` with the residual ``errors``.
 
     Parameters
@@ -63,6 +113,8 @@ def drift(mission: Mission, errors: ResidualErrors, runs: int = 1000, seed: int 
         The files and figures the analysis came from, kept in the result.
     progress : callable, optional
         Called with the number of main runs done.
+    flicker_span : int
+        Flicker is synthesised down to ``1 / (flicker_span T)`` (:func:`align.navigation.closed.flicker_lines`).
 
     Returns
     -------
@@ -71,33 +123,45 @@ def drift(mission: Mission, errors: ResidualErrors, runs: int = 1000, seed: int 
     Raises
     ------
     InputError
-        No residual error given.
+        No residual error given; a flicker span out of range.
     """
     if not errors.terms():
-        raise InputError("no residual error to propagate: give an Allan result, an alignment or calibration result, "
-                         "a budget, a part or a residual bias", "{allan}")
-    mc = monte_carlo(mission, errors, runs, seed, nav_rate, points, progress)
+        raise InputError("no residual error to propagate: give at least one of {allan}, {alignment}, {budget}, "
+                         "{imu}, {gyro_bias}, {accel_bias}")
+    if not (isinstance(flicker_span, (int, np.integer)) and 2 <= flicker_span <= MAX_FLICKER_SPAN):
+        raise InputError(f"the flicker span must be a whole number of mission lengths from 2 to {MAX_FLICKER_SPAN}",
+                         "{flicker_span}")
+    mc = monte_carlo(mission, errors, runs, seed, nav_rate, points, progress, flicker_span)
     notes = ["quantization noise is left out (its angle and velocity errors stay bounded)",
              "the navigation frame is local level and Earth-fixed without transport rate (seed 002 Eq 2: low speed, "
-             "small area): no Schuler feedback, so errors grow as the closed forms' powers of time"]
+             "small area): no Schuler feedback, so errors grow as the closed forms' powers of time",
+             f"down velocity and position: their second-order part g eps^2 / 2 (eps the tilt error) is one-signed, so "
+             f"mean -/+ 3 sigma is no 99.7 % bound there: the picture draws the percentiles of the first "
+             f"{min(runs, KEEP):,} runs for them (the file's down 'percentiles')"]
+    notes += _error_notes(mission, errors, flicker_span)
+    rate = _rate_note(mission.fs, nav_rate, mc.nav_rate)
+    if rate:
+        notes.append(rate)
     closed = None
     if mission.kind == "static":
         steps = int(round(mc.t[-1] * mission.fs / navigation_step(mission.fs, nav_rate)))
         terms = term_sigmas(errors, mc.t, mission.gravity, mission.heading, mission.earth_body,
-                            duration=float(mc.t[-1]), points=slow_grid(steps))
+                            duration=float(mc.t[-1]), points=slow_grid(steps), span=flicker_span)
         closed = static_sigma(terms, mc.sigma.shape)
         method = "closed forms E1-E4 of each term (align.navigation.closed)"
         if mission.earth_rate:
             notes.append(f"the closed forms leave out the Earth-rate couplings (omega_ie t = "
-                         f"{7.292115e-5 * mc.t[-1]:.3g} rad at the end)")
+                         f"{EARTH_RATE * mc.t[-1]:.3g} rad at the end)")
         note = _agreement_note(mc.sigma, closed, runs)
         if note:
             notes.append(note)
     else:
         n = min(runs, term_runs)
-        terms = term_monte_carlo(mission, errors, n, seed, nav_rate, points)
+        terms = term_monte_carlo(mission, errors, n, seed, nav_rate, points, flicker_span)
         method = f"a Monte Carlo of {n} runs with each error term alone"
     rows = dominance(mc.t, terms)
+    if not rows:
+        notes.append("no error term grows on this mission: every component stays zero (see the notes above)")
     final = {label(*k): v[-1] for k, v in terms.items()}
     for key in ("gyroscope", "accelerometer"):
         s = errors.gyro if key == "gyroscope" else errors.accel
@@ -105,5 +169,6 @@ def drift(mission: Mission, errors: ResidualErrors, runs: int = 1000, seed: int 
             notes.append(f"no {key} error given: its errors are taken as zero")
     info = dict(inputs or {})
     info.setdefault("initial_heading_deg", mission.heading / DEG)
+    info.setdefault("flicker_span", flicker_span)
     return DriftResult(mission.to_dict(), errors, mc.t, mc.mean, mc.sigma, closed, final, tuple(rows),
-                       dominance_text(rows), method, runs, seed, mc.nav_rate, info, tuple(notes))
+                       dominance_text(rows), method, runs, seed, mc.nav_rate, info, tuple(notes), mc.down_percentiles)

@@ -21,7 +21,13 @@ over :data:`~align.navigation.closed.SYNTHESIS_SPAN` mission lengths (the lines 
 :func:`align.flicker.flicker_fft`), the random walk ``b_j = b_j-1 + K sqrt(hc) w``. The terms
 left out of (M1-M3) are second order (an error times the rotation within one step). The mean and
 the standard deviation over the runs are kept at up to ``points`` times (Chan's pairwise update
-over chunks of runs; no run is stored).
+over chunks of runs; no run is stored), and the percentiles of :data:`PERCENTILES` of the down
+velocity and position over the first :data:`KEEP` runs (their second-order part ``g eps^2 / 2`` of a
+tilt error ``eps`` is one-signed: mean +/- k sigma is no bound there).
+
+A rigid mounting rotation of the whole IMU (``ResidualErrors.mount``) is an initial attitude error:
+each run starts from ``q0 (x) exp(r)`` with ``r ~ N(0, diag(mount^2))`` (body frame) while the
+truth starts from ``q0``; the sensors' readings are the IMU's own, unchanged.
 
 Public names
 ------------
@@ -35,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit, prange
 
-from align.attitude import qexp
+from align.attitude import qexp, quat_from_rotvec, quat_multiply
 from align.errors import InputError
 from align.navigation.closed import SYNTHESIS_SPAN, flicker_lines
 from align.navigation.mission import Mission
@@ -49,6 +55,12 @@ SLOW_INTERVALS = 128
 CHUNK_BYTES = 48e6
 #: the default navigation rate, Hz (the sensor's rate when slower)
 NAV_RATE = 10.0
+#: percentiles kept of the down channels (the central 68.27 % and 99.73 %, and the median)
+PERCENTILES = (0.135, 15.865, 50.0, 84.135, 99.865)
+#: runs whose down channels are kept for the percentiles
+KEEP = 2000
+#: the columns of the down velocity and position (closed.QUANTITIES)
+DOWN = (5, 8)
 
 
 @dataclass(frozen=True, eq=False)
@@ -65,6 +77,8 @@ class MonteCarlo(Value):
     nav_rate : float
         Navigation update rate, Hz.
     seed : int
+    down_percentiles : ndarray, shape (len(PERCENTILES), P, 2)
+        Percentiles of the down velocity and position over the first ``min(runs, KEEP)`` runs.
     """
 
     t: np.ndarray
@@ -73,6 +87,7 @@ class MonteCarlo(Value):
     runs: int
     nav_rate: float
     seed: int
+    down_percentiles: np.ndarray | None = None
 
 
 def navigation_step(fs: float, nav_rate: float | None) -> int:
@@ -102,12 +117,12 @@ def _record(q, v, p, te, tv, tp, out):
 
 
 @njit(parallel=True, cache=True)
-def _runs(dth, dv, h, q0, g, wie, mg, ma, slow_g, slow_a, hc, white_g, white_a, wsd, out_idx, te, tv, tp, err):
+def _runs(dth, dv, h, q0s, g, wie, mg, ma, slow_g, slow_a, hc, white_g, white_a, wsd, out_idx, te, tv, tp, err):
     runs, steps, slots = mg.shape[0], dth.shape[0], slow_g.shape[1]
     qe = qexp(-wie * h)
     wide_g, wide_a = white_g.shape[1] > 1, white_a.shape[1] > 1
     for r in prange(runs):
-        q, v, p = q0.copy(), np.zeros(3), np.zeros(3)
+        q, v, p = q0s[r].copy(), np.zeros(3), np.zeros(3)
         th, du = np.empty(3), np.empty(3)
         o = 0
         if out_idx[0] == 0:
@@ -135,20 +150,25 @@ def _runs(dth, dv, h, q0, g, wie, mg, ma, slow_g, slow_a, hc, white_g, white_a, 
                 o += 1
 
 
-def _flicker(rng: np.random.Generator, runs: int, points: int, hc: float, b: np.ndarray) -> np.ndarray:
+def _flicker(rng: np.random.Generator, runs: int, points: int, hc: float, b: np.ndarray,
+             span: int = SYNTHESIS_SPAN) -> np.ndarray:
     """Flicker of PSD ``B^2 / (pi f)`` at ``points`` grid times (runs, points, 3) (closed.flicker_lines)."""
-    n = SYNTHESIS_SPAN * (points - 1)
-    f, c2 = flicker_lines((points - 1) * hc, points)
+    n = span * (points - 1)
+    f, c2 = flicker_lines((points - 1) * hc, points, span)
     amp = np.sqrt(c2) * n / 2.0  # irfft: a line X_k = A (u + i v) gives (2 A / n) (u cos - v sin)
     amp[-1] = np.sqrt(c2[-1]) * n  # the Nyquist line appears once, real
-    spec = np.zeros((n // 2 + 1, runs * 3), complex)
-    spec[1:] = amp[:, None] * (rng.standard_normal((len(f), runs * 3)) + 1j * rng.standard_normal((len(f), runs * 3)))
-    spec[-1] = spec[-1].real
-    series = np.fft.irfft(spec, n, axis=0)[:points]
+    series = np.empty((points, runs * 3))
+    group = max(1, int(CHUNK_BYTES // (16 * (n // 2 + 1))))  # columns synthesised at once: bounded memory
+    for c in range(0, runs * 3, group):
+        cols = min(group, runs * 3 - c)
+        spec = np.zeros((n // 2 + 1, cols), complex)
+        spec[1:] = amp[:, None] * (rng.standard_normal((len(f), cols)) + 1j * rng.standard_normal((len(f), cols)))
+        spec[-1] = spec[-1].real
+        series[:, c:c + cols] = np.fft.irfft(spec, n, axis=0)[:points]
     return series.reshape(points, runs, 3).transpose(1, 0, 2) * b
 
 
-def _slow(rng, s: SensorErrors, runs: int, points: int, hc: float) -> np.ndarray:
+def _slow(rng, s: SensorErrors, runs: int, points: int, hc: float, span: int = SYNTHESIS_SPAN) -> np.ndarray:
     """Turn-on bias, ramp, flicker and random walk of one sensor on the grid (runs, points, 3)."""
     t = np.arange(points) * hc
     out = np.zeros((runs, points, 3))
@@ -157,7 +177,7 @@ def _slow(rng, s: SensorErrors, runs: int, points: int, hc: float) -> np.ndarray
     if np.any(s.ramp > 0):
         out += (rng.standard_normal((runs, 3)) * s.ramp)[:, None, :] * t[None, :, None]
     if np.any(s.flicker > 0):
-        out += _flicker(rng, runs, points, hc, s.flicker)
+        out += _flicker(rng, runs, points, hc, s.flicker, span)
     if np.any(s.random_walk > 0):
         steps = rng.standard_normal((runs, points - 1, 3)) * s.random_walk * np.sqrt(hc)
         out[:, 1:] += np.cumsum(steps, axis=1)
@@ -165,16 +185,24 @@ def _slow(rng, s: SensorErrors, runs: int, points: int, hc: float) -> np.ndarray
 
 
 def _matrix(rng, s: SensorErrors, runs: int) -> np.ndarray:
-    """``dM`` of each run (runs, 3, 3): element sigmas and a random-direction tilt of each axis."""
+    """``dM`` of each run (runs, 3, 3): element sigmas and a random-direction tilt of each axis (rms ``tilt_i``:
+    ``N(0, tilt_i^2 / 2)`` on each of the row's two other elements)."""
     out = np.zeros((runs, 3, 3))
     if np.any(s.matrix > 0):
         out += rng.standard_normal((runs, 3, 3)) * s.matrix
     if np.any(s.tilt > 0):
-        a = rng.uniform(0, 2 * np.pi, (runs, 3))
+        lean = rng.standard_normal((runs, 3, 2)) * (s.tilt / np.sqrt(2))[None, :, None]
         for i in range(3):
-            out[:, i, (i + 1) % 3] += s.tilt[i] * np.cos(a[:, i])
-            out[:, i, (i + 2) % 3] += s.tilt[i] * np.sin(a[:, i])
+            out[:, i, (i + 1) % 3] += lean[:, i, 0]
+            out[:, i, (i + 2) % 3] += lean[:, i, 1]
     return out
+
+
+def _starts(rng, q0: np.ndarray, mount: np.ndarray, runs: int) -> np.ndarray:
+    """The initial attitude of each run (runs, 4): ``q0 (x) exp(r)``, ``r ~ N(0, diag(mount^2))`` (body frame)."""
+    if not np.any(mount > 0):
+        return np.tile(q0, (runs, 1))
+    return quat_multiply(q0[None, :], quat_from_rotvec(rng.standard_normal((runs, 3)) * mount))
 
 
 def slow_grid(steps: int) -> int:
@@ -189,7 +217,7 @@ def _outputs(steps: int, points: int) -> np.ndarray:
 
 
 def monte_carlo(mission: Mission, errors: ResidualErrors, runs: int, seed: int = 0, nav_rate: float | None = None,
-                points: int = 601, progress=None) -> MonteCarlo:
+                points: int = 601, progress=None, flicker_span: int = SYNTHESIS_SPAN) -> MonteCarlo:
     """Mean and 1-sigma of the navigation error over ``runs`` runs (module docstring).
 
     Parameters
@@ -205,6 +233,9 @@ def monte_carlo(mission: Mission, errors: ResidualErrors, runs: int, seed: int =
         Times kept (evenly spaced navigation steps, the last included).
     progress : callable, optional
         Called with the number of runs done so far.
+    flicker_span : int
+        Flicker is synthesised over this many mission lengths: its lowest frequency is
+        ``1 / (flicker_span T)`` (:func:`~align.navigation.closed.flicker_lines`).
 
     Returns
     -------
@@ -230,14 +261,17 @@ def monte_carlo(mission: Mission, errors: ResidualErrors, runs: int, seed: int =
     rng = np.random.default_rng(seed)
     chunk = int(max(2, min(256, CHUNK_BYTES // (steps * 3 * 4 * sum(noisy))))) if any(noisy) else 256
     count, mean, m2 = 0, np.zeros((len(idx), 9)), np.zeros((len(idx), 9))
+    kept = []
     while count < runs:
         r = min(chunk, runs - count)
         white = [rng.standard_normal((r, steps, 3), np.float32) if on else np.zeros((r, 1, 3), np.float32)
                  for on in noisy]
         err = np.zeros((r, len(idx), 9))
-        _runs(dth, dv, h, mission.q0.copy(), g, wie, _matrix(rng, gy, r), _matrix(rng, ac, r),
-              _slow(rng, gy, r, slots, hc), _slow(rng, ac, r, slots, hc), hc, white[0], white[1], wsd, idx, te, tv, tp,
-              err)
+        _runs(dth, dv, h, _starts(rng, mission.q0, errors.mount, r), g, wie, _matrix(rng, gy, r), _matrix(rng, ac, r),
+              _slow(rng, gy, r, slots, hc, flicker_span), _slow(rng, ac, r, slots, hc, flicker_span), hc, white[0],
+              white[1], wsd, idx, te, tv, tp, err)
+        if count < KEEP:
+            kept.append(err[: KEEP - count][:, :, DOWN])
         cm = err.mean(axis=0)
         cm2 = ((err - cm) ** 2).sum(axis=0)
         delta = cm - mean
@@ -247,11 +281,14 @@ def monte_carlo(mission: Mission, errors: ResidualErrors, runs: int, seed: int =
         count = total
         if progress is not None:
             progress(count)
-    return MonteCarlo(idx * h, mean, np.sqrt(m2 / (runs - 1)), runs, mission.fs / m, seed)
+    down = np.percentile(np.concatenate(kept), PERCENTILES, axis=0)
+    return MonteCarlo(idx * h, mean, np.sqrt(m2 / (runs - 1)), runs, mission.fs / m, seed, down)
 
 
 def term_monte_carlo(mission: Mission, errors: ResidualErrors, runs: int, seed: int = 0,
-                     nav_rate: float | None = None, points: int = 601) -> dict[tuple[str, str], np.ndarray]:
+                     nav_rate: float | None = None, points: int = 601,
+                     flicker_span: int = SYNTHESIS_SPAN) -> dict[tuple[str, str], np.ndarray]:
     """The 1-sigma (P, 9) each error term alone gives: a Monte Carlo of ``runs`` runs per term."""
-    return {(s, k): monte_carlo(mission, errors.only(s, k), runs, seed + 1 + i, nav_rate, points).sigma
+    return {(s, k): monte_carlo(mission, errors.only(s, k), runs, seed + 1 + i, nav_rate, points,
+                                flicker_span=flicker_span).sigma
             for i, (s, k) in enumerate(errors.terms())}

@@ -8,24 +8,50 @@ with ``x`` the true rate (specific force), ``dM`` the residual scale (diagonal) 
 (off-diagonal) error, ``b`` the residual turn-on bias, ``r`` a rate ramp, and the noise of the
 IEEE five-term model (reference section 6): white (``N``, angle/velocity random walk), flicker
 (bias instability ``B``, PSD ``B^2 / (pi f)``), random walk (``K``). Every term is zero-mean
-and drawn per run: ``b ~ N(0, sigma_b^2)``, ``dM_ij ~ N(0, sigma_M,ij^2)``, ``r ~ N(0, R^2)``;
-a mounting budget's per-axis angle ``theta_i`` tilts sensor axis ``i`` by ``theta_i`` in a
-direction drawn uniformly about it (``dM_ij = theta_i cos a``, ``dM_ik = theta_i sin a``).
+and drawn per run: ``b ~ N(0, sigma_b^2)``, ``dM_ij ~ N(0, sigma_M,ij^2)``, ``r ~ N(0, R^2)``.
+
+A mounting budget (the angle ``P_i`` between each axis of the IMU and its system axis; its per-axis
+RSS, taken as the **rms** angle, i.e. a 1-sigma figure of a zero-mean draw) is one of two things
+(:data:`MOUNT_ERRORS`):
+
+* ``"attitude"`` (default): the whole IMU (gyros and accelerometers together) is turned by a rigid
+  rotation ``r`` relative to the vehicle, ``r_k ~ N(0, s_k^2)`` about body axis ``k``, with ``s``
+  chosen so that each axis' rms misalignment is the budget's (an axis moves by the rotations about
+  the other two: ``P_x^2 = s_y^2 + s_z^2``, ...)::
+
+      s_x^2 = (P_y^2 + P_z^2 - P_x^2) / 2,  s_y^2 = (P_x^2 + P_z^2 - P_y^2) / 2,
+      s_z^2 = (P_x^2 + P_y^2 - P_z^2) / 2                                              (R2)
+
+  With the initial attitude taken as the vehicle's, this is an **initial attitude error** of the
+  navigation (``ResidualErrors.mount``): a tilt ``eps`` puts ``g eps`` into the horizontal channels
+  from ``t = 0`` (velocity ``g eps t``, position ``g eps t^2 / 2``), a heading error stays constant;
+* ``"turns"``: the initial attitude is aligned in place by the IMU itself (levelled by its own
+  accelerometers), which absorbs a rigid rotation; what is left is the gyro axes' misalignment
+  relative to that frame (``SensorErrors.tilt``: axis ``i`` leans by ``theta_i = P_i`` rms in a
+  random direction, ``dM_ij, dM_ik ~ N(0, theta_i^2 / 2)``). It acts only through the body's turns
+  (and the Earth rate): a static mission costs nothing from it.
 
 Where each figure comes from (:func:`residual_errors`):
 
 * an ``allan`` result: ``N, B, K, R`` of the fit of each channel (quantization is left out: its
   angle error stays bounded); with several runs, the run-to-run repeatability is the turn-on bias;
-* an ``alignment`` or ``calibrate`` result: ``sigma_M`` and ``sigma_bias`` (the estimate's
-  uncertainty is the residual after it is applied);
-* a mounting budget: its per-axis RSS angle as the gyro axes' uncompensated misalignment;
+* an ``alignment`` or ``calibrate`` result: ``sigma_M`` and ``sigma_bias``, the estimate's
+  uncertainty, is the residual after it is applied. With ``raw = M x + b`` corrected by
+  ``x^ = M^-1 (raw - b^)``, errors ``dM, db`` of the estimate leave ``x^ = (I - A dM) x - A db``
+  (``A = M^-1``): the residual scale and misalignment is ``A dM`` (relative, whatever the unit of
+  ``M``: dimensionless or counts per SI unit) and the residual bias ``A db`` in SI::
+
+      sigma(A dM)_ij^2 = sum_k A_ik^2 sigma_M,kj^2,   sigma(A db)_i^2 = sum_k A_ik^2 sigma_b,k^2   (R3)
+
+  (the estimate's correlations are not in the file: left out);
+* a mounting budget: R2, as above;
 * a datasheet preset: angle random walk (or noise density) and bias instability ``B`` (as the
   preset table and the planner read it: :attr:`align.parts.Part.bias_instability`);
 * stated figures: a residual bias of each sensor.
 
 Public names
 ------------
-SensorErrors, ResidualErrors, residual_errors, TERM_KEYS, label
+SensorErrors, ResidualErrors, residual_errors, mount_rotation, TERM_KEYS, MOUNT_ERRORS, label
 """
 
 from __future__ import annotations
@@ -48,11 +74,14 @@ _LABELS = {
                       "tilt": "accel mounting misalignment", "white": "velocity random walk",
                       "flicker": "accel bias instability", "random_walk": "acceleration random walk",
                       "ramp": "acceleration ramp"},
+    "imu": {"mount": "IMU mounting rotation (initial attitude error)"},
 }
+#: what a mounting budget's angles are taken as (module docstring)
+MOUNT_ERRORS = ("attitude", "turns")
 #: display units of each term in a file: (gyroscope, accelerometer)
 UNITS = {"bias": ("deg/h", "ug"), "matrix": ("ppm", "ppm"), "tilt": ("deg", "deg"),
          "white": ("deg/sqrt(h)", "m/s/sqrt(h)"), "flicker": ("deg/h", "ug"),
-         "random_walk": ("deg/h/sqrt(h)", "ug/sqrt(h)"), "ramp": ("deg/h^2", "ug/h")}
+         "random_walk": ("deg/h/sqrt(h)", "ug/sqrt(h)"), "ramp": ("deg/h^2", "ug/h"), "mount": ("deg", "deg")}
 
 
 def label(sensor: str, term: str) -> str:
@@ -77,7 +106,7 @@ class SensorErrors(Value):
     matrix : ndarray, shape (3, 3)
         1-sigma of each element of ``dM`` (dimensionless).
     tilt : ndarray, shape (3,)
-        Misalignment angle of each axis in a random direction (rad).
+        rms misalignment angle of each axis, in a random direction (rad): ``dM_ij, dM_ik ~ N(0, tilt_i^2 / 2)``.
     white, flicker, random_walk, ramp : ndarray, shape (3,)
         ``N`` (rad/sqrt(s), m/s/sqrt(s)), ``B`` (rad/s, m/s^2), ``K`` (rad/s/sqrt(s), m/s^2/sqrt(s)),
         ``R`` (rad/s^2, m/s^3).
@@ -140,27 +169,69 @@ class SensorErrors(Value):
 
 @dataclass(frozen=True, eq=False)
 class ResidualErrors(Value):
-    """The residual errors of both sensors."""
+    """The residual errors of both sensors, and the rigid mounting rotation of the whole IMU.
+
+    Attributes
+    ----------
+    gyro, accel : SensorErrors
+    mount : ndarray, shape (3,)
+        1-sigma of the IMU's rotation about body x, y, z relative to the vehicle (rad): the initial
+        attitude error common to both sensors (module docstring, R2).
+    mount_source : str
+        Where ``mount`` comes from.
+    """
 
     gyro: SensorErrors = field(default_factory=lambda: SensorErrors("gyroscope"))
     accel: SensorErrors = field(default_factory=lambda: SensorErrors("accelerometer"))
+    mount: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    mount_source: str = ""
+
+    def __post_init__(self) -> None:
+        mount = np.broadcast_to(np.nan_to_num(np.asarray(self.mount, float)), (3,))
+        if np.any(mount < 0):
+            raise InputError(f"a residual {label('imu', 'mount')} must be >= 0", label("imu", "mount"))
+        object.__setattr__(self, "mount", frozen_array(mount))
+        super().__post_init__()
 
     def terms(self) -> list[tuple[str, str]]:
-        """``(sensor, term)`` of every non-zero term."""
-        return [(s.sensor, k) for s in (self.gyro, self.accel) for k in s.active()]
+        """``(sensor, term)`` of every non-zero term (``("imu", "mount")`` for the mounting rotation)."""
+        out = [(s.sensor, k) for s in (self.gyro, self.accel) for k in s.active()]
+        return out + ([("imu", "mount")] if np.any(self.mount > 0) else [])
 
     def only(self, sensor: str, term: str) -> ResidualErrors:
         """Only one term of one sensor (the others zero): for a one-term Monte Carlo."""
         return ResidualErrors(self.gyro.only(term if sensor == "gyroscope" else None),
-                              self.accel.only(term if sensor == "accelerometer" else None))
+                              self.accel.only(term if sensor == "accelerometer" else None),
+                              self.mount if sensor == "imu" else np.zeros(3), self.mount_source)
 
     def to_dict(self) -> dict:
-        return {"gyroscope": self.gyro.to_dict(), "accelerometer": self.accel.to_dict()}
+        return {"gyroscope": self.gyro.to_dict(), "accelerometer": self.accel.to_dict(),
+                "imu": {"mount": {"label": label("imu", "mount"), "unit": "deg", "value": to_unit(self.mount, "deg").tolist(),
+                                  "source": self.mount_source or None}}}
 
     @classmethod
     def from_dict(cls, d: dict) -> ResidualErrors:
+        mount = d.get("imu", {}).get("mount", {"value": [0.0] * 3, "unit": "deg"})  # absent in the first files
+        from align.units import parse_unit
+
         return cls(SensorErrors.from_dict("gyroscope", d["gyroscope"]),
-                   SensorErrors.from_dict("accelerometer", d["accelerometer"]))
+                   SensorErrors.from_dict("accelerometer", d["accelerometer"]),
+                   np.array(mount["value"], float) * parse_unit(mount["unit"]).factor, mount.get("source") or "")
+
+
+def mount_rotation(per_axis) -> tuple[np.ndarray, bool]:
+    """The 1-sigma rotation about x, y, z (rad) whose rms axis misalignments are ``per_axis`` (rad) (R2).
+
+    Returns
+    -------
+    s : ndarray, shape (3,)
+    clipped : bool
+        A square came out negative (one axis' figure exceeds the other two's RSS: no rigid rotation
+        gives it) and was set to zero.
+    """
+    p2 = np.asarray(per_axis, float) ** 2
+    s2 = (p2.sum() - 2 * p2) / 2
+    return np.sqrt(np.clip(s2, 0.0, None)), bool(np.any(s2 < 0))
 
 
 def _three(values, what: str, where: str) -> np.ndarray:
@@ -199,13 +270,20 @@ def _from_correction(result, where: str) -> dict[str, tuple[dict, dict]]:
         if not (np.all(np.isfinite(sm)) and np.all(np.isfinite(sb))):
             raise InputError(f"its {sensor} result states no uncertainty (sigma of M and bias); "
                              "the residual errors come from it: regenerate it", where)
-        note = f"1-sigma of the {sensor} estimate in {where}"
-        found[sensor] = ({"matrix": sm, "bias": sb}, {"matrix": note, "bias": note})
+        m = np.asarray(cal.M, float)
+        if not (np.all(np.isfinite(m)) and abs(np.linalg.det(m)) > 0):
+            raise InputError(f"its {sensor} M is singular; regenerate it", where)
+        a2 = np.linalg.inv(m) ** 2
+        units = getattr(cal, "units", "")
+        note = (f"1-sigma of the {sensor} estimate in {where}, through M^-1 (relative scale and misalignment, "
+                f"bias in SI{'; M in counts' if units == 'counts' else ''})")
+        found[sensor] = ({"matrix": np.sqrt(a2 @ sm**2), "bias": np.sqrt(a2 @ sb**2)}, {"matrix": note, "bias": note})
     return found
 
 
 def residual_errors(allan=(), correction=None, budget=None, part=None, gyro_bias: float | None = None,
-                    accel_bias: float | None = None, where: dict | None = None) -> ResidualErrors:
+                    accel_bias: float | None = None, where: dict | None = None,
+                    mount_error: str = "attitude") -> ResidualErrors:
     """The residual error set of a mission from the results and figures given (module docstring).
 
     Parameters
@@ -213,15 +291,17 @@ def residual_errors(allan=(), correction=None, budget=None, part=None, gyro_bias
     allan : sequence of AllanJob
         At most one per sensor (a gyroscope and/or an accelerometer Allan result).
     correction : AlignmentResult or CalibrationSet, optional
-        Its uncertainties are the residual scale, misalignment and bias.
+        Its uncertainties are the residual scale, misalignment and bias (R3).
     budget : mechanics Budget, optional
-        Its per-axis angles are the gyro axes' uncompensated misalignment (no alignment applied).
+        Its per-axis angles (rms), uncompensated: as ``mount_error`` says (module docstring).
     part : align.parts.Part, optional
         Datasheet noise figures, used for the gyro when no gyro Allan result is given.
     gyro_bias, accel_bias : float, optional
         Residual turn-on bias 1-sigma (rad/s, m/s^2): replaces any other source of it.
     where : dict, optional
         Names of the inputs for messages and sources (keys ``allan``, ``correction``, ``budget``, ``part``).
+    mount_error : {"attitude", "turns"}
+        What the budget is taken as (:data:`MOUNT_ERRORS`).
 
     Returns
     -------
@@ -258,13 +338,28 @@ def residual_errors(allan=(), correction=None, budget=None, part=None, gyro_bias
                 s["bias"] = f"{s['bias']} (root-sum-square with {sources[sensor]['bias']})"
             values[sensor].update(v)
             sources[sensor].update(s)
+    mount, mount_source = np.zeros(3), ""
+    if mount_error not in MOUNT_ERRORS:
+        raise InputError(f"choose {' or '.join(MOUNT_ERRORS)} (got {mount_error!r})", "{mount_error}")
     if budget is not None:
-        values["gyroscope"]["tilt"] = np.asarray(budget.per_axis, float)
-        sources["gyroscope"]["tilt"] = (f"per-axis RSS misalignment of the budget {where.get('budget', 'given')} "
-                                        "(no alignment applied)")
+        per_axis = np.asarray(budget.per_axis, float)
+        shown = "/".join(f"{v:.4g}" for v in to_unit(per_axis, "deg"))
+        bname = where.get("budget", "given")
+        if mount_error == "turns":
+            values["gyroscope"]["tilt"] = per_axis
+            sources["gyroscope"]["tilt"] = (f"per-axis RSS of the budget {bname} ({shown} deg) as the rms misalignment "
+                                            "of each gyro axis, random direction, relative to a frame aligned in place")
+        else:
+            mount, clipped = mount_rotation(per_axis)
+            mount_source = (f"budget {bname}: per-axis RSS {shown} deg (x/y/z) taken as each axis' rms misalignment; "
+                            "rigid rotation of the whole IMU, 1-sigma about x/y/z "
+                            + "/".join(f"{v:.4g}" for v in to_unit(mount, "deg")) + " deg (R2)"
+                            + ("; one axis' figure exceeds the RSS of the other two: no rigid rotation gives it, "
+                               "its square was clipped at zero" if clipped else ""))
     for sensor, value, name in (("gyroscope", gyro_bias, "{gyro_bias}"), ("accelerometer", accel_bias, "{accel_bias}")):
         if value is not None:
             values[sensor]["bias"] = _three(value, "bias", name)
             sources[sensor]["bias"] = f"stated residual {sensor} bias"
     return ResidualErrors(SensorErrors("gyroscope", **values["gyroscope"], sources=sources["gyroscope"]),
-                          SensorErrors("accelerometer", **values["accelerometer"], sources=sources["accelerometer"]))
+                          SensorErrors("accelerometer", **values["accelerometer"], sources=sources["accelerometer"]),
+                          mount, mount_source)

@@ -4,7 +4,9 @@ Its file holds ``time_s`` and, for each of ``attitude_deg`` (``roll``, ``pitch``
 ``velocity_m_s`` and ``position_m`` (``north``, ``east``, ``down``), the ``mean`` and ``sigma`` of
 the Monte Carlo over time (the 1-sigma and 3-sigma envelopes are ``mean -/+ sigma`` and
 ``mean -/+ 3 sigma``) and, for a static mission, the ``closed_form_sigma`` of
-:mod:`align.navigation.closed`; the residual errors used and their sources, the mission, each
+:mod:`align.navigation.closed`; the down velocity and position also carry ``percentiles`` (of
+:data:`align.navigation.montecarlo.PERCENTILES`, over the first runs: their second-order part is
+one-signed, so mean -/+ 3 sigma is no 99.7 % bound there); the residual errors used and their sources, the mission, each
 term's 1-sigma at the end, and which error dominates when (``dominant``, ``dominance``).
 
 Public names
@@ -20,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from align.errors import InputError
+from align.navigation.montecarlo import PERCENTILES
 from align.navigation.residuals import ResidualErrors
 from align.results import Result
 from align.units import DEG
@@ -72,6 +75,8 @@ class DriftResult(Result, format=FORMAT, convention=CONVENTION):
         Hz.
     inputs : dict
     notes : tuple of str
+    down_percentiles : ndarray, shape (len(PERCENTILES), P, 2), or None
+        Percentiles of the down velocity (m/s) and position (m) over the first runs.
     """
 
     mission: dict
@@ -89,6 +94,7 @@ class DriftResult(Result, format=FORMAT, convention=CONVENTION):
     nav_rate: float
     inputs: dict = field(default_factory=dict)
     notes: tuple = ()
+    down_percentiles: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -115,10 +121,14 @@ class DriftResult(Result, format=FORMAT, convention=CONVENTION):
                 entry = {"mean": (self.mean[:, col] * factor).tolist(), "sigma": (self.sigma[:, col] * factor).tolist()}
                 if self.closed is not None:
                     entry["closed_form_sigma"] = (self.closed[:, col] * factor).tolist()
-                d[group][name] = entry
                 final[group][name] = {"mean": float(self.mean[-1, col] * factor),
                                       "sigma": float(self.sigma[-1, col] * factor),
                                       "three_sigma": float(3 * self.sigma[-1, col] * factor)}
+                if name == "down" and self.down_percentiles is not None:
+                    pc = self.down_percentiles[:, :, 0 if group == "velocity_m_s" else 1]
+                    entry["percentiles"] = {f"{p:g}": v.tolist() for p, v in zip(PERCENTILES, pc)}
+                    final[group][name]["percentiles"] = {f"{p:g}": float(v[-1]) for p, v in zip(PERCENTILES, pc)}
+                d[group][name] = entry
         d["final"] = final
         d["term_sigma_final"] = {
             term: {group: {name: float(v[col] * factor) for name, col in zip(names, _columns(group))}
@@ -139,7 +149,7 @@ class DriftResult(Result, format=FORMAT, convention=CONVENTION):
         try:
             t = np.array(d["time_s"], float)
             mean, sigma = np.zeros((len(t), 9)), np.zeros((len(t), 9))
-            closed = None
+            closed, pct = None, None
             for group, (names, factor) in GROUPS.items():
                 for name, col in zip(names, _columns(group)):
                     entry = d[group][name]
@@ -148,6 +158,10 @@ class DriftResult(Result, format=FORMAT, convention=CONVENTION):
                     if "closed_form_sigma" in entry:
                         closed = np.zeros((len(t), 9)) if closed is None else closed
                         closed[:, col] = np.array(entry["closed_form_sigma"], float) / factor
+                    if name == "down" and "percentiles" in entry:
+                        pct = np.zeros((len(PERCENTILES), len(t), 2)) if pct is None else pct
+                        for k, p in enumerate(PERCENTILES):
+                            pct[k, :, 0 if group == "velocity_m_s" else 1] = np.array(entry["percentiles"][f"{p:g}"])
             term_final = {}
             for term, groups in d.get("term_sigma_final", {}).items():
                 v = np.zeros(9)
@@ -158,7 +172,7 @@ class DriftResult(Result, format=FORMAT, convention=CONVENTION):
             return cls(dict(d["mission"]), ResidualErrors.from_dict(d["errors"]), t, mean, sigma, closed, term_final,
                        tuple(d.get("dominant", ())), str(d.get("dominance", "")), str(d.get("dominance_method", "")),
                        int(d["runs"]), int(d["seed"]), float(d["nav_rate_hz"]), dict(d.get("inputs", {})),
-                       tuple(d.get("notes", ())))
+                       tuple(d.get("notes", ())), pct)
         except (KeyError, TypeError, ValueError, AttributeError, IndexError) as exc:
             raise InputError(f"malformed {FORMAT} result ({malformed(exc)}); regenerate it", where) from None
 

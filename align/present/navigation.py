@@ -5,8 +5,8 @@ pitch, heading; north, east, down velocity; north, east, down position) against 
 Carlo mean, its 1-sigma and 3-sigma envelopes and, for a static mission, the closed forms' +/- 1
 sigma and 3 sigma. The down channels' second-order part (``g eps^2 / 2`` of a tilt error) is
 one-signed: there the envelopes are the runs' percentiles (central 68.27 % and 99.73 %), not
-mean +/- k sigma, so that no band shows values no run reaches. :func:`navigation_section` is the report's section; :func:`drift_summary` the
-terminal's.
+mean +/- k sigma, so that no band shows values no run reaches. :func:`navigation_section` is the
+report's section; :func:`drift_summary` the terminal's.
 
 Public names
 ------------
@@ -120,7 +120,8 @@ def navigation_section(result, png: bytes | None) -> Section:
             f"(seed {result.seed}).</p>",
             "<p>Residual errors (1-sigma, drawn per run):</p>",
             table(["term", "value", "unit", "source"], _error_rows(result)),
-            f"<p>Errors at {t_end:g} s (Monte Carlo; the envelopes are mean +/- 1 and 3 sigma):</p>",
+            f"<p>Errors at {t_end:g} s (Monte Carlo; the envelopes are mean +/- 1 and 3 sigma, those of the one-signed "
+            "down channels the runs' percentiles):</p>",
             table(["component", "mean", "1 sigma", "3 sigma"], _final_rows(result)),
             f"<p><b>Which error dominates when</b> ({esc(result.dominance_method)}):</p>",
             "<ul>" + "".join(f"<li>{esc(line)}</li>" for line in result.dominance.splitlines()) + "</ul>"]
@@ -140,6 +141,10 @@ def drift_summary(result) -> str:
              f"{'at the end':<26}{'mean':>12}{'1 sigma':>12}{'3 sigma':>12}"]
     for row in _final_rows(result):
         lines.append(f"{row[0]:<26}{row[1]:>12}{row[2]:>12}{row[3]:>12}")
+    if result.down_percentiles is not None:
+        end = result.down_percentiles[:, -1, :]
+        lines.append(f"down, central 99.73 % of the runs: velocity {end[0, 0]:.4g} to {end[-1, 0]:.4g} m/s, "
+                     f"position {end[0, 1]:.4g} to {end[-1, 1]:.4g} m (one-signed second order: see the notes)")
     lines.append(f"which error dominates when ({result.dominance_method}):")
     lines += ["  " + line for line in result.dominance.splitlines()] or ["  none: no error term grows on this mission"]
     lines += [f"note: {n}" for n in result.notes]

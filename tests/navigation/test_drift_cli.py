@@ -70,7 +70,8 @@ def test_a_scale_error_costs_its_fraction_of_the_turn():
 def test_drift_with_a_manoeuvre_file_and_a_budget(run_cli, tmp_path):
     out = tmp_path / "m.json"
     r = run_cli("drift", "--manoeuvre", ROOT / "examples/sensitivity/sequence.toml", "--budget",
-                ROOT / "examples/budget/example1.toml", "--duration", "1 min", "--runs", "100", "--json", out)
+                ROOT / "examples/budget/example1.toml", "--mount-error", "turns", "--duration", "1 min", "--runs", "100",
+                "--json", out)
     assert r.code == 0, r.err
     d = json.loads(out.read_text())
     assert d["mission"]["kind"] == "manoeuvre" and "z +90 deg; x +45 deg" in d["mission"]["description"]
@@ -100,7 +101,8 @@ def test_residuals_from_a_calibration_file(run_cli, tmp_path):
 
 
 @pytest.mark.parametrize("args, words", [
-    (["--duration", "1 min"], "no residual error to propagate: give an Allan result"),
+    (["--duration", "1 min"], "no residual error to propagate: give at least one of --allan, --alignment, --budget, "
+                              "--imu, --gyro-bias, --accel-bias"),
     (["--duration", "1 min", "--imu", "ADIS16485", "--alignment", "a.json", "--budget", "b.toml"], "--alignment"),
     (["--duration", "0 s", "--imu", "ADIS16485"], "--duration"),
     (["--duration", "1 min", "--imu", "NOPE"], "unknown part"),
