@@ -2,7 +2,7 @@
 
 ``batch`` runs every unit of a manifest (:mod:`align.production.manifest`) through the very command
 a user would type for it alone: a worker calls :func:`align.cli.run` in its own process with the
-unit's words (``matrix LOG --plan PLAN ... --json OUT/units/SERIAL.json``), its output captured, and
+unit's words (``matrix LOG --plan PLAN ... --json OUT/units/SERIAL.JOB.json``), its output captured, and
 records the exit status and the command's one-line error against the serial; the unit's JSON,
 written atomically by the command itself, is read back for the lot's table. No job is run any
 other way, so a unit's result and its refusal are exactly the single command's.
@@ -23,88 +23,7 @@ from typing import Annotated
 import typer
 
 from align.cli import options as opt
-
-#: job -> (the option its manifest ``plan`` column is given as, whether it needs one)
-JOBS: dict[str, tuple[str | None, str]] = {
-    "matrix": ("--plan", "required"),
-    "calibrate ferraris": ("--sections", "required"),
-    "calibrate accel": ("--positions", "optional"),
-    "calibrate mag": (None, "none"),
-    "calibrate gyro": (None, "none"),
-    "allan": (None, "none"),
-}
-#: options the batch gives every unit itself
-RESERVED = ("--json", "--help", "--version")
-#: options naming files a command writes (not inputs: they do not enter the content hash)
-OUTPUT_OPTIONS = ("--c-header", "--plot", "--imucal-json", "--json")
-
-
-def _jobs() -> dict[str, str]:
-    """The jobs this installation has, each with its use of the plan column."""
-    from align.cli import COMMANDS
-
-    have = {name if not subs else f"{name} {s}" for name, subs in COMMANDS.items() for s in (subs or (None,))}
-    return {job: use for job, (_, use) in JOBS.items() if job in have}
-
-
-def _command(job: str):
-    from align.cli import alignment, calibrate, noise
-
-    words = job.split()
-    return calibrate.COMMANDS[words[1]] if words[0] == "calibrate" else {**alignment.COMMANDS, **noise.COMMANDS}[words[0]]
-
-
-def _path_options(job: str) -> set[str]:
-    """The options of ``job`` whose value is a file (``--segments``, ``--plot``): resolved against the manifest."""
-    import typing
-
-    found: set[str] = set()
-    for hint in typing.get_type_hints(_command(job), include_extras=True).values():
-        if typing.get_origin(hint) is not Annotated:
-            continue
-        base, *meta = typing.get_args(hint)
-        if Path in (typing.get_args(base) or (base,)):
-            for m in meta:  # typer.Option("--plot", ...) in Annotated: the flag is its first argument, "default"
-                names = [getattr(m, "default", None), *(getattr(m, "param_decls", ()) or ())]
-                found |= {d for d in names if isinstance(d, str) and d.startswith("--")}
-    return found
-
-
-def _resolved(options: tuple[str, ...], files: set[str], folder: Path) -> tuple[list[str], list[Path]]:
-    """The options with file values made absolute (relative to ``folder``), and the input files among them."""
-    out, inputs, i = [], [], 0
-    while i < len(options):
-        word = options[i]
-        name, eq, text = word.partition("=")
-        if name in files and (eq or i + 1 < len(options)):
-            value = text if eq else options[i + 1]
-            path = (folder / value).resolve()
-            out += [f"{name}={path}"] if eq else [name, str(path)]
-            if name not in OUTPUT_OPTIONS:
-                inputs.append(path)
-            i += 1 if eq else 2
-            continue
-        out.append(word)
-        i += 1
-    return out, inputs
-
-
-def _task_maker(folder: Path):
-    from align.production import Task
-
-    files = {job: _path_options(job) for job in _jobs()}
-
-    def make(unit, result: Path, run: str) -> Task:
-        flag = JOBS[unit.job][0]
-        options, inputs = _resolved(unit.options, files[unit.job], folder)
-        args = [*unit.job.split(), str(unit.log)]
-        if unit.plan is not None:
-            args += [flag, str(unit.plan)]
-        args += [*options, "--json", str(result.resolve())]
-        return Task(unit, tuple(args), result.resolve(), (unit.log, unit.plan, *inputs), run)
-
-    return make
-
+from align.cli.batchjobs import JOBS, OUTPUT_OPTIONS, RESERVED, _jobs, _task_maker, check_options  # noqa: F401
 
 # ---- the worker: the single command, run in this process with its output captured ----
 
@@ -190,13 +109,16 @@ def batch(
                       "allan; options as the single command takes them.", "MANIFEST"),
     workers: Workers = None,
     scheduler: Scheduler = None,
-    out: opt.OptInput("--out", "Output folder: units/SERIAL.json and results.parquet (default: the manifest's "
+    out: opt.OptInput("--out", "Output folder: units/SERIAL.JOB.json and results.parquet (default: the manifest's "
                       "folder).", "DIR") = None,
     spec: opt.OptInput("--spec", "Limits per figure (TOML), to judge each unit as it finishes.", "SPEC.toml") = None,
+    rerun: Annotated[bool, typer.Option("--rerun", help=(
+        "Run every unit again, even those whose result is there with the same inputs and imu-align version."))]
+    = False,
 ) -> None:
     """Run every unit of a manifest through its single command (matrix, calibrate ..., allan), in parallel.
 
-    Each unit's result goes to OUT/units/SERIAL.json, its key figures to OUT/results.parquet (appended). A rerun
+    Each unit's result goes to OUT/units/SERIAL.JOB.json, its key figures to OUT/results.parquet (appended). A rerun
     skips units whose result is there and whose inputs are unchanged. Exit status: 0 every unit ran (and passed
     the spec); 3 some units failed or gave an error; 4 some units are outside the spec.
     """
@@ -218,20 +140,18 @@ def batch(
     jobs = _jobs()
     lot = read_manifest(manifest, jobs)
     for unit in lot.units:
-        for word in unit.options:
-            if word.partition("=")[0] in RESERVED:
-                raise InputError(f"{unit.row}, column options: {word.partition('=')[0]} is the batch's own (each "
-                                 "unit's result goes to OUT/units/SERIAL.json); remove it", str(manifest))
+        check_options(unit, str(manifest))
     limits = read_spec(spec) if spec is not None else None
     folder = out if out is not None else lot.folder
     created = output_folder("out", folder)
     folder.mkdir(parents=True, exist_ok=True)
     pool = make_pool(workers or os.cpu_count() or 1, scheduler)
     started = time.perf_counter()
-    run = BatchRun(total=len(lot.units))
+    run = BatchRun(total=len({u.serial for u in lot.units}))
     try:
         with locked(folder):
-            tasks, skipped = plan_tasks(lot.units, folder, _task_maker(lot.folder.resolve()), now().isoformat())
+            tasks, skipped = plan_tasks(lot.units, folder, _task_maker(lot.folder.resolve()), now().isoformat(),
+                                        rerun=rerun)
             run.add(rejudge_rows(skipped, limits), skipped=True)  # judged again: the spec may be another
             if tasks:
                 with pool, progress(len(tasks), "units") as tick:

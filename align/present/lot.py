@@ -52,7 +52,7 @@ def batch_summary(run, manifest: str, where: str, table_path, seconds: float) ->
     ran = run.units()
     ok, outside = run.lot("ok"), run.lot("ok", "fail")
     failed, errors = run.lot("failed"), run.lot("error")
-    lines = [f"batch of {manifest} on {where}: {run.total} units; ran {len(ran)}, skipped {len(run.lot()) - len(ran)} "
+    lines = [f"batch of {manifest} on {where}: {run.total} unit{'s' if run.total != 1 else ''}; ran {len(ran)}, skipped {len(run.lot()) - len(ran)} "
              f"(done before, inputs unchanged); {len(ok)} ok" + (f" ({len(outside)} outside the spec)" if outside else "")
              + f", {len(failed)} failed, {len(errors)} errors",
              f"{seconds:.1f} s" + (f", {len(ran) / seconds:.2f} units/s" if ran and seconds > 0 else "")
@@ -69,7 +69,7 @@ def _stats_rows(stats) -> list[list]:
     for fs in stats.figures:
         s, ss = _slope(fs, stats)
         ref = fs.shown(fs.std)
-        rows.append([fs.figure, fs.sensor, fs.limit.describe() if fs.limit else "", fs.unit, fs.n,
+        rows.append([fs.figure, fs.sensor, fs.job, fs.limit.describe() if fs.limit else "", fs.unit, fs.n,
                      _num(fs.shown(fs.mean), True, ref), _num(ref, False, ref), _num(fs.shown(fs.minimum), True, ref),
                      _num(fs.shown(fs.maximum), True, ref),
                      f"{fs.cpk:.2f} ± {fs.cpk_sigma:.2f}" if fs.limit and math.isfinite(fs.cpk_sigma) else "-",
@@ -79,7 +79,7 @@ def _stats_rows(stats) -> list[list]:
     return rows
 
 
-_HEADER = ["figure", "sensor", "limit", "unit", "n", "mean", "std", "min", "max", "Cpk", "yield", "outliers"]
+_HEADER = ["figure", "sensor", "job", "limit", "unit", "n", "mean", "std", "min", "max", "Cpk", "yield", "outliers"]
 
 
 def lot_summary(stats, source: str) -> str:
@@ -87,19 +87,23 @@ def lot_summary(stats, source: str) -> str:
     if not stats.count:
         return f"lot of {source}: no units"
     spec = f", spec {stats.spec.path}" if stats.spec else " (no spec: no limits, Cpk or yield)"
-    lines = [f"lot of {source}: {stats.count} units (each one's latest run){spec}",
-             f"yield {stats.passed} of {stats.count} = {100 * stats.yield_:.1f} % +/- {100 * stats.yield_sigma:.1f} % "
-             "(units passing every limit; units that failed or gave an error count as not passing)", ""]
+    lo, hi = stats.yield_interval
+    lines = [f"lot of {source}: {stats.count} units (serials; each job's latest run){spec}",
+             f"yield {stats.passed} of {stats.count} = {100 * stats.yield_:.1f} % (95 % Wilson interval "
+             f"{100 * lo:.1f} to {100 * hi:.1f} %; units passing every limit; units that failed, gave an error or "
+             "have a limit not checked count as not passing)"]
+    lines += [f"note: {n}" for n in stats.notes] + [""]
     header = _HEADER + [f"trend {_per(stats)}"]
     rows = [[str(c) for c in r] for r in _stats_rows(stats)]
     widths = [max(len(h), *(len(r[i]) for r in rows)) if rows else len(h) for i, h in enumerate(header)]
     for r in [header] + rows:
-        lines.append("  ".join(c.ljust(w) if i < 4 else c.rjust(w) for i, (c, w) in enumerate(zip(r, widths))).rstrip())
-    lines.append("(* a trend beyond 3 sigma; mean, std, min, max, trend in each figure's unit)")
+        lines.append("  ".join(c.ljust(w) if i < 5 else c.rjust(w) for i, (c, w) in enumerate(zip(r, widths))).rstrip())
+    lines.append("(* a trend beyond 3 sigma; mean, std, min, max, trend in each figure's unit; populations by job, "
+                 "sensor and unit: counts apart from SI)")
     bad = [u for u in stats.units if u.verdict != "pass"]
     if bad:
         lines += ["", f"units not passing ({len(bad)}):"]
-        lines += [f"  {u.serial:<12} {u.verdict:<7} {'; '.join(u.reasons)}" for u in bad]
+        lines += [f"  {u.serial:<12} {u.verdict:<9} {'; '.join(u.reasons)}" for u in bad]
     outliers: dict[str, list[str]] = {}
     for fs in stats.figures:
         for s in fs.outliers:
@@ -108,6 +112,12 @@ def lot_summary(stats, source: str) -> str:
         lines += ["", "outliers (robust z-score beyond 3.5): "
                   + ", ".join(f"{s} ({', '.join(f)})" for s, f in outliers.items())]
     return "\n".join(lines)
+
+
+def _wide(html: str) -> str:
+    """A table kept within the page: scrolled sideways when wider, in a smaller type, cells not wrapped mid-value."""
+    return ('<div style="overflow-x:auto;max-width:100%;font-size:85%"><style>.lotw td{white-space:nowrap}</style>'
+            f'<div class="lotw">{html}</div></div>')
 
 
 def _pyplot():
@@ -146,19 +156,20 @@ def _limits(ax, fs, vertical: bool) -> None:
             (ax.axvline if vertical else ax.axhline)(fs.shown(b), color="tab:red", ls="--", lw=1.2)
 
 
-def _legend(ax, fs, *lines) -> None:
+def _legend(ax, fs, spec: bool, *lines) -> None:
     from matplotlib.lines import Line2D
 
     handles = [Line2D([], [], color=c, ls=ls, label=label) for label, c, ls in lines]
     if fs.limit is not None:
         handles.append(Line2D([], [], color="tab:red", ls="--", label="spec limits"))
-    handles.append(Line2D([], [], color="tab:red", marker="o", ls="", label="outside the spec"))
+    if spec:
+        handles.append(Line2D([], [], color="tab:red", marker="o", ls="", label="outside the spec"))
     ax.legend(handles=handles, fontsize=6, loc="upper right", framealpha=0.8)
 
 
-def histograms_png(stats) -> bytes:
-    """A histogram per figure (at most :data:`MAX_PANELS`) with its spec limits (red dashes) and its mean."""
-    figs = stats.figures[:MAX_PANELS]
+def histograms_png(stats, start: int = 0) -> bytes:
+    """A histogram per figure (:data:`MAX_PANELS` from ``start``) with its spec limits (red dashes) and its mean."""
+    figs = stats.figures[start:start + MAX_PANELS]
     plt, fig, axes = _grid(len(figs))
     for ax, fs in zip(axes, figs):
         v = np.array([fs.shown(x) for x in fs.values])
@@ -174,18 +185,19 @@ def histograms_png(stats) -> bytes:
         _limits(ax, fs, True)
         ax.axvline(fs.shown(fs.mean), color="k", lw=0.8)
         cpk = f", Cpk {fs.cpk:.2f}" if fs.limit is not None and math.isfinite(fs.cpk) else ""
-        ax.set_title(f"{fs.figure} ({fs.sensor}){cpk}", fontsize=9)
+        ax.set_title(f"{fs.figure} ({fs.sensor}, {fs.job}){cpk}", fontsize=9)
         if ax is axes[0]:
-            _legend(ax, fs, ("mean", "k", "-"))
+            _legend(ax, fs, stats.spec is not None, ("mean", "k", "-"))
         ax.set_xlabel(fs.unit if fs.unit != "1" else "ratio", fontsize=8)
         ax.tick_params(labelsize=7)
     return _png(plt, fig)
 
 
-def control_charts_png(stats) -> bytes:
+def control_charts_png(stats, start: int = 0) -> bytes:
     """An individuals chart per figure: each unit over the lot's order (or days), the mean, the control limits
-    (mean -/+ 3 MR/1.128, grey) and the spec limits (red dashes); units outside the spec in red."""
-    figs = stats.figures[:MAX_PANELS]
+    (mean -/+ 3 MR/1.128, grey) and the spec limits (red dashes); units outside the spec in red
+    (:data:`MAX_PANELS` figures from ``start``)."""
+    figs = stats.figures[start:start + MAX_PANELS]
     plt, fig, axes = _grid(len(figs))
     for ax, fs in zip(axes, figs):
         v = np.array([fs.shown(x) for x in fs.values])
@@ -198,9 +210,9 @@ def control_charts_png(stats) -> bytes:
             if math.isfinite(c):
                 ax.axhline(fs.shown(c), color="0.4", ls=":", lw=1)
         _limits(ax, fs, False)
-        ax.set_title(f"{fs.figure} ({fs.sensor})", fontsize=9)
+        ax.set_title(f"{fs.figure} ({fs.sensor}, {fs.job})", fontsize=9)
         if ax is axes[0]:
-            _legend(ax, fs, ("mean", "k", "-"), ("control limits", "0.4", ":"))
+            _legend(ax, fs, stats.spec is not None, ("mean", "k", "-"), ("control limits", "0.4", ":"))
         ax.set_xlabel("days since the first unit" if stats.trend_by == "time" else "unit (lot order)", fontsize=8)
         ax.set_ylabel(fs.unit if fs.unit != "1" else "ratio", fontsize=8)
         ax.tick_params(labelsize=7)
@@ -212,22 +224,30 @@ def lot_report_html(stats, source: str) -> str:
     sections = []
     bad = [u for u in stats.units if u.verdict != "pass"]
     verdict = "pass" if not bad else "fail"
+    lo, hi = stats.yield_interval
     banner = (f'<p class="banner {verdict}">yield {stats.passed} of {stats.count} = {100 * stats.yield_:.1f} % '
-              f"&plusmn; {100 * stats.yield_sigma:.1f} %: " + ("every unit passes" if not bad else
-                                                                f"{len(bad)} units do not pass") + "</p>")
-    sections.append(Section("Summary", banner + '<p class="note">Each unit\'s latest run; units that failed or gave '
-                            "an error count as not passing. Spec: " + esc(stats.spec.path if stats.spec else "none")
-                            + ".</p>"))
+              f"(95 % Wilson interval {100 * lo:.1f} to {100 * hi:.1f} %): "
+              + ("every unit passes" if not bad else f"{len(bad)} units do not pass") + "</p>")
+    notes = "".join(f'<p class="note">{esc(n)}</p>' for n in stats.notes)
+    sections.append(Section("Summary", banner + '<p class="note">Each unit (serial) judged by its jobs\' latest runs; '
+                            "units that failed, gave an error or have a limit not checked count as not passing. Spec: "
+                            + esc(stats.spec.path if stats.spec else "none") + ".</p>" + notes))
     if bad:
         rows = [[u.serial, u.job, (u.verdict, "fail"), "; ".join(u.reasons)] for u in bad]
-        sections.append(Section(f"Units not passing ({len(bad)})", table(["serial", "job", "verdict", "why"], rows, 4)))
+        sections.append(Section(f"Units not passing ({len(bad)})",
+                                _wide(table(["serial", "jobs", "verdict", "why"], rows, 4))))
     if stats.figures:
         header = _HEADER + [f"trend {_per(stats)}"]
-        sections.append(Section("Statistics", table(header, _stats_rows(stats), 4) + '<p class="note">Mean, std, '
-                                "min, max and trend in each figure's unit; Cpk &plusmn; its standard error; outliers "
-                                "by the robust z-score (beyond 3.5); * a trend beyond 3 sigma.</p>"))
-        sections.append(Section("Histograms", image(histograms_png(stats), "histogram of each figure with its limits")))
-        sections.append(Section("Control charts", image(control_charts_png(stats), "individuals control charts")))
+        sections.append(Section("Statistics", _wide(table(header, _stats_rows(stats), 5)) + '<p class="note">Mean, '
+                                "std, min, max and trend in each figure's unit; Cpk &plusmn; its standard error; "
+                                "outliers by the robust z-score (beyond 3.5, from 8 units on); * a trend beyond 3 "
+                                "sigma. Each job, sensor and unit (counts or SI) is its own population.</p>"))
+        starts = range(0, len(stats.figures), MAX_PANELS)
+        sections.append(Section("Histograms", "".join(
+            image(histograms_png(stats, k), "histogram of each figure with its limits") for k in starts)
+            + f'<p class="note">All {len(stats.figures)} figures, {MAX_PANELS} per picture.</p>'))
+        sections.append(Section("Control charts", "".join(
+            image(control_charts_png(stats, k), "individuals control charts") for k in starts)))
         outl = [[s, fs.figure, fs.sensor] for fs in stats.figures for s in fs.outliers]
         if outl:
             sections.append(Section("Outliers", table(["serial", "figure", "sensor"], outl, 3)))

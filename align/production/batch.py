@@ -9,8 +9,9 @@ what was done.
 
 Resuming: a unit is skipped when its result file exists and the table's latest row for it (serial
 and job) succeeded with the same content hash of its inputs (:func:`align.production.manifest.input_hash`:
-job, options, the bytes of its log, plan and input files). Any other unit runs again; its old result
-file is removed first, so that a unit that fails now leaves no result of other inputs behind.
+the imu-align version, job, options, the bytes of its log, plan and input files); ``rerun`` skips none.
+Any other unit runs again; its old result file is removed first, so that a unit that fails now leaves no
+result of other inputs behind.
 
 Public names
 ------------
@@ -36,6 +37,8 @@ from align.production.table import Journal, latest_rows, now, read_table
 TABLE = "results.parquet"
 #: the folder of the units' result files in the output folder
 UNITS = "units"
+#: verdicts from best to worst (a serial's summary is its worst row)
+_RANK = {"pass": 0, "warn": 1, "fail": 2, "failed": 3, "error": 4}
 #: what a :class:`BatchRun` keeps of each row
 KEPT = ("serial", "order", "slot", "job", "sensor", "status", "exit_code", "verdict", "message")
 
@@ -50,7 +53,7 @@ class Task:
     args : tuple of str
         The single command's words, e.g. ``("matrix", LOG, <plan option>, PLAN, ..., <json option>, RESULT)``.
     result : Path
-        The unit's result file, ``OUT/units/SERIAL.json``.
+        The unit's result file, ``OUT/units/SERIAL.JOB.json``.
     inputs : tuple of Path or None
         The files the content hash covers (log, plan, input files the options name).
     run : str
@@ -82,7 +85,7 @@ class BatchRun:
     skipped : list of dict
         The table's latest rows of the units skipped (their result was there with the same inputs).
     total : int
-        Units in the manifest.
+        Units (serials) in the manifest.
     """
 
     rows: list = field(default_factory=list)
@@ -95,17 +98,17 @@ class BatchRun:
 
     @staticmethod
     def _first(rows: list, status: str | None, verdict: str | None) -> list[dict]:
-        seen, out = set(), []
+        """One row per serial: its worst over its jobs and sensors (error, failed, fail, warn, pass)."""
+        worst: dict[str, dict] = {}
         for r in rows:
-            if r["serial"] in seen:
-                continue
-            seen.add(r["serial"])
-            if (status is None or r["status"] == status) and (verdict is None or r["verdict"] == verdict):
-                out.append(r)
-        return out
+            have = worst.get(r["serial"])
+            if have is None or _RANK.get(r.get("verdict"), 0) > _RANK.get(have.get("verdict"), 0):
+                worst[r["serial"]] = r
+        return [r for r in worst.values()
+                if (status is None or r["status"] == status) and (verdict is None or r["verdict"] == verdict)]
 
     def units(self, status: str | None = None, verdict: str | None = None) -> list[dict]:
-        """One row per unit run now (its first), optionally only those of a ``status`` or ``verdict``."""
+        """One row per unit (serial) run now (its worst), optionally only those of a ``status`` or ``verdict``."""
         return self._first(self.rows, status, verdict)
 
     def lot(self, status: str | None = None, verdict: str | None = None) -> list[dict]:
@@ -145,7 +148,7 @@ def unit_rows(task: Task, exit_code: int, message: str, digest: str, seconds: fl
 
 
 def plan_tasks(units: Iterable[Unit], out: Path, make: Callable[[Unit, Path, str], Task],
-               run: str) -> tuple[list[Task], list[dict]]:
+               run: str, rerun: bool = False) -> tuple[list[Task], list[dict]]:
     """The tasks to run, and the table's latest rows of the units to skip (see the module docstring), the
     journal of a killed run folded first.
 
@@ -158,6 +161,8 @@ def plan_tasks(units: Iterable[Unit], out: Path, make: Callable[[Unit, Path, str
         ``make(unit, result_path, run) -> Task``: the single command's words for the unit.
     run : str
         This run's id.
+    rerun : bool
+        Run every unit, skipping none.
     """
     table_path = out / TABLE
     Journal(table_path).recover()
@@ -166,9 +171,9 @@ def plan_tasks(units: Iterable[Unit], out: Path, make: Callable[[Unit, Path, str
         last.setdefault((r["serial"], r["job"]), []).append(r)
     todo, skipped = [], []
     for unit in units:
-        task = make(unit, out / UNITS / f"{unit.serial}.json", run)
+        task = make(unit, out / UNITS / unit.result_name, run)
         prev = last.get((unit.serial, unit.job))
-        if (prev is not None and prev[0]["status"] == "ok" and task.result.exists()
+        if (not rerun and prev is not None and prev[0]["status"] == "ok" and task.result.exists()
                 and prev[0]["input_hash"] == task.digest()):
             skipped += [{**r, "order": unit.order, "slot": unit.slot} for r in prev]
             continue

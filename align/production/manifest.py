@@ -52,7 +52,8 @@ class Unit:
     Attributes
     ----------
     serial : str
-        The unit's serial number (its result file is ``SERIAL.json``).
+        The unit's serial number (its result file is ``SERIAL.JOB.json``, the job's words joined by ``-``;
+        one serial may have several jobs, each (serial, job) once).
     job : str
         The single-unit command, e.g. ``"matrix"`` or ``"calibrate accel"``.
     log : Path
@@ -77,6 +78,11 @@ class Unit:
     slot: str | None
     order: int
     row: str
+
+    @property
+    def result_name(self) -> str:
+        """The unit's result file name: ``SN0001.calibrate-accel.json``."""
+        return f"{self.serial}.{'-'.join(self.job.split())}.json"
 
 
 @dataclass(frozen=True)
@@ -120,10 +126,11 @@ def read_manifest(path: str | Path, jobs: Mapping[str, str]) -> Manifest:
     units, seen = [], {}
     for order, (row, record) in enumerate(records):
         unit = _unit(record, row, order, folder, jobs, str(p))
-        if unit.serial in seen:
-            raise InputError(f"{row}, column serial: {unit.serial} is also the serial of {seen[unit.serial]}; "
-                             "give each unit its own", str(p))
-        seen[unit.serial] = row
+        key = (unit.serial.lower(), unit.job)  # case-only differences collide on case-insensitive file systems
+        if key in seen:
+            raise InputError(f"{row}, column serial: {unit.serial} with job {unit.job} is also stated at {seen[key]}; "
+                             "give each (serial, job) once (a serial may have several jobs)", str(p))
+        seen[key] = row
         units.append(unit)
     return Manifest(p, tuple(units))
 
@@ -227,10 +234,13 @@ def input_hash(job: str, options: Iterable[str], files: Iterable[Path | None]) -
     """The content hash (SHA-256, hex) of a unit's inputs: its job, its options as typed, and the bytes of
     each input file in order (a missing file hashes as missing, so that it counts as changed once it exists).
 
-    Two units hash alike exactly when their job, options and input contents are the same; the files'
-    names and times do not enter.
+    Two units hash alike exactly when their job, options and input contents and the imu-align version
+    (``align.__version__``: a release that changes an estimator reruns every unit) are the same; the
+    files' names and times do not enter.
     """
-    h = hashlib.sha256(b"imu-align batch inputs 1\0")
+    from align import __version__
+
+    h = hashlib.sha256(b"imu-align batch inputs 1\0" + str(__version__).encode() + b"\0")
     h.update(hashlib.sha256("\0".join([job, *options]).encode()).digest())
     for path in files:
         h.update(_file_digest(path))

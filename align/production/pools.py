@@ -94,6 +94,10 @@ class DaskPool:
                 self._client = distributed.Client(self._cluster)
             else:
                 self._client = distributed.Client(self.address, timeout=CONNECT_TIMEOUT)
+        except ValueError as exc:  # not an address at all ('bogus': no port)
+            self.close()
+            raise InputError(f"'{self.address}' is not a Dask scheduler address ({' '.join(str(exc).split())[:120]}); "
+                             "give tcp://HOST:PORT, or 'local'", "{scheduler}") from None
         except OSError as exc:  # no scheduler there (a timeout is an OSError too)
             self.close()
             raise InputError(f"cannot reach the Dask scheduler at {self.address} ({' '.join(str(exc).split())[:160]}); "

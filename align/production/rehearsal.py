@@ -14,11 +14,13 @@ six-dwell rate-table test (+/- ``rate`` about x, y, z) simulated by
 Written into ``folder``: ``plan.toml``, ``sessions/SERIAL.csv`` (time in s, gyro columns in
 deg/s), ``manifest.csv`` (job ``matrix``) and ``truth.csv``: per unit its serial, order, slot,
 kind (``good`` or the bad kind), the true ``M_ij`` and ``bias_i`` (rad/s) and the figures of ``M``
-(:mod:`align.production.figures`, SI).
+(:mod:`align.production.figures`, SI). ``truth.csv``'s first line is a comment (``#``) stating its
+format, version, the imu-align version, the convention and every column's unit (:data:`TRUTH_HEADER`);
+:func:`read_truth` reads it back and checks it.
 
 Public names
 ------------
-LotSpread, LotTruth, simulate_lot, lot_plan, BAD_KINDS
+LotSpread, LotTruth, simulate_lot, lot_plan, read_truth, BAD_KINDS, TRUTH_FORMAT, TRUTH_UNITS
 """
 
 from __future__ import annotations
@@ -184,7 +186,7 @@ def simulate_lot(folder: str | Path, n: int, spread: LotSpread = LotSpread(), se
                       **{f"bias_{a}": float(v) for a, v in zip("xyz", model.bias)},
                       **{k2: v for k2, v in matrix_figures(model.M, None).items() if not k2.startswith("M_")}})
     _write_rows(root / "manifest.csv", manifest)
-    _write_rows(root / "truth.csv", units)
+    _write_rows(root / "truth.csv", units, _truth_comment())
     return LotTruth(root, root / "manifest.csv", root / "plan.toml", root / "truth.csv", tuple(units))
 
 
@@ -198,10 +200,51 @@ def _turned(model: SensorModel, angle: float, axis: int) -> SensorModel:
     return SensorModel(model.M @ r.T, model.bias)
 
 
-def _write_rows(path: Path, rows: list[dict]) -> None:
+#: the format named in truth.csv's comment line
+TRUTH_FORMAT = "imu-align.lot-truth"
+#: truth.csv's units per column prefix (everything SI)
+TRUTH_UNITS = {"M_": "1", "bias_": "rad/s", "scale_": "1", "phi_": "rad", "delta_": "rad", "rotation_": "rad"}
+
+
+def _truth_comment() -> str:
+    from align import __version__
+
+    units = " ".join(f"{k}*={v}" for k, v in TRUTH_UNITS.items())
+    return (f"# format={TRUTH_FORMAT} version=1 generator=imu-align {__version__}; convention: g = M w + bias, "
+            f"rows of M are sensor axes; units: {units}")
+
+
+def read_truth(path: str | Path) -> tuple[dict, list[dict]]:
+    """Read a ``truth.csv`` back: ``(header, rows)``; ``header`` the comment line's ``key=value`` items
+    (``format``, ``version``, ``generator``) and ``units`` (column prefix -> unit); rows as strings.
+
+    Raises
+    ------
+    InputError
+        The file does not start with the comment line of :data:`TRUTH_FORMAT`.
+    """
+    import io
+
+    from align.io.files import read_text
+
+    text = read_text(path)
+    first, _, rest = text.partition("\n")
+    if not first.startswith(f"# format={TRUTH_FORMAT} "):
+        raise InputError(f"not a lot truth file (its first line is not '# format={TRUTH_FORMAT} ...')", str(path))
+    head, _, units = first[2:].partition("; units: ")
+    meta = dict(item.split("=", 1) for item in head.split(";")[0].split() if "=" in item)
+    meta["generator"] = head.split("generator=", 1)[1].split(";")[0]
+    meta["convention"] = head.split("convention: ", 1)[1] if "convention: " in head else ""
+    meta["units"] = {k.rstrip("*"): v for k, v in (u.split("=", 1) for u in units.split())}
+    return meta, list(csv.DictReader(io.StringIO(rest)))
+
+
+def _write_rows(path: Path, rows: list[dict], comment: str = "") -> None:
     import io
 
     buf = io.StringIO()
+    if comment:
+        buf.write(comment + "\n")
     writer = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
     writer.writeheader()
     writer.writerows(rows)

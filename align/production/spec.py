@@ -4,7 +4,8 @@
 
     phi_xy = { abs_max = "0.1 deg" }            # |phi_xy| <= 0.1 deg
     "phi_*" = { abs_max = "0.1 deg" }           # every cross-axis angle (shell-style pattern)
-    scale_x = { min = 0.995, max = 1.005 }      # plain numbers for ratios ("0.5 %" works too)
+    scale_x = { min = 0.995, max = 1.005 }      # plain numbers for ratios
+    "scale_*" = { abs_max = "0.5 %" }           # a scale limit in % or ppm: the deviation from 1 (|scale - 1|)
     arw_x = { max = "0.3 deg/sqrt(h)" }         # an angular unit: applies to gyroscopes
     bias_x = { abs_max = "0.05 m/s^2" }         # an acceleration: applies to accelerometers
 
@@ -13,7 +14,10 @@
 
 A limit of a figure whose unit depends on the sensor (bias, noise terms) applies to the sensors
 whose figure has the limit's dimension; one of another dimension is refused. A figure is shown
-in the unit its limit is written in.
+in the unit its limit is written in. A scale limit written in % or ppm bounds the deviation from 1
+(``abs_max = "0.5 %"``: ``0.995 <= scale <= 1.005``); a scale limit whose range excludes 1 is refused.
+Two keys limiting one figure of one sensor (``phi_xy`` and ``"phi_*"``) are refused, naming both.
+``coverage``, ``spread`` and ``heading_error`` apply to magnetometers only.
 
 Public names
 ------------
@@ -36,6 +40,8 @@ from align.units import parse_unit, to_unit
 #: the sensors a row may be of, and a spec table may be named after
 SENSORS = ("gyroscope", "accelerometer", "magnetometer")
 _BOUNDS = ("min", "max", "abs_max")
+#: figures only a magnetometer calibration gives
+MAGNETOMETER_ONLY = ("coverage", "spread", "heading_error", "field")
 _NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*)$")
 
 
@@ -61,6 +67,8 @@ class Limit:
     high: float | None
     unit: str
     symmetric: bool = False
+    key: str = ""
+    offset: float = 0.0
 
     def applies(self, sensor: str | None) -> bool:
         """True for a row of ``sensor``."""
@@ -72,18 +80,19 @@ class Limit:
 
     def shown(self, value: float) -> float:
         """``value`` (SI) in the limit's unit."""
-        return float(to_unit(value, self.unit)) if self.unit != "1" else float(value)
+        return float(to_unit(value - self.offset, self.unit)) if self.unit != "1" else float(value - self.offset)
 
     def describe(self) -> str:
         """``|phi_xy| <= 0.1 deg``, ``0.995 <= scale_x <= 1.005``, ``arw_x <= 0.3 deg/sqrt(h)``."""
         u = "" if self.unit == "1" else f" {self.unit}"
+        name = f"{self.figure} - 1" if self.offset else self.figure
         if self.symmetric:
-            return f"|{self.figure}| <= {self.shown(self.high):g}{u}"
+            return f"|{name}| <= {self.shown(self.high):g}{u}"
         if self.low is not None and self.high is not None:
-            return f"{self.shown(self.low):g} <= {self.figure} <= {self.shown(self.high):g}{u}"
+            return f"{self.shown(self.low):g} <= {name} <= {self.shown(self.high):g}{u}"
         if self.high is not None:
-            return f"{self.figure} <= {self.shown(self.high):g}{u}"
-        return f"{self.figure} >= {self.shown(self.low):g}{u}"
+            return f"{name} <= {self.shown(self.high):g}{u}"
+        return f"{name} >= {self.shown(self.low):g}{u}"
 
 
 @dataclass(frozen=True)
@@ -120,6 +129,15 @@ def read_spec(path: str | Path) -> Spec:
             limits += _limits(key, value, None, key, where)
     if not limits:
         raise InputError("states no limit; give e.g. phi_xy = { abs_max = \"0.1 deg\" }", where)
+    seen: dict[tuple[str, str], Limit] = {}
+    for lim in limits:
+        for s in SENSORS if lim.sensor == "" else (lim.sensor,):
+            other = seen.get((lim.figure, s))
+            if other is not None and other.key != lim.key:
+                raise InputError(f"{literal(other.key)} and {literal(lim.key)} both limit {lim.figure}"
+                                 + (f" of the {s}" if lim.sensor or other.sensor else "")
+                                 + "; give each figure one limit (remove one key or narrow its pattern)", where)
+            seen[(lim.figure, s)] = lim
     return Spec(where, tuple(limits))
 
 
@@ -157,6 +175,14 @@ def _limits(pattern: str, value, sensor: str | None, key: str, where: str) -> li
     if not isinstance(value, dict) or not value:
         raise InputError(f"{literal(key)}: give its limits as a table, e.g. {{ min = ..., max = ... }} or "
                          "{ abs_max = ... }", where)
+    if sensor is None and not any(fnmatch.fnmatchcase(f, pattern) for f in FIGURES):
+        import difflib
+
+        close = difflib.get_close_matches(pattern, list(SENSORS), n=1, cutoff=0.4)
+        if close or not set(value) & set(_BOUNDS):
+            raise InputError(f"{literal(key)}: neither a figure nor a sensor table"
+                             + (f" (did you mean {close[0]}?)" if close else "") + f"; the sensor tables are "
+                             f"{', '.join(SENSORS)}", where)
     for name in value:
         if name not in _BOUNDS:
             raise InputError(f"{literal(key)}: unknown bound '{literal(name)}'; use min, max or abs_max", where)
@@ -165,12 +191,17 @@ def _limits(pattern: str, value, sensor: str | None, key: str, where: str) -> li
     out = []
     for figure in _figures(pattern, key, where):
         bounds = {n: _bound(v, figure, key, n, where) for n, v in value.items()}
+        if figure.startswith("scale_") and len({v[1].strip() in ("%", "ppm") for v in bounds.values()}) > 1:
+            raise InputError(f"{literal(key)}: give both bounds in % (a deviation from 1) or both as ratios", where)
         dims = {b[2] for b in bounds.values()}
         if len(dims) > 1:
             raise InputError(f"{literal(key)}: its bounds are of different dimensions; write them in one unit", where)
         dim = dims.pop()
         unit = next(iter(bounds.values()))[1]
-        if sensor:
+        if figure in MAGNETOMETER_ONLY:
+            sensors = [sensor] if sensor in (None, "magnetometer") else []
+            sensors = ["magnetometer"] if sensor is None else sensors
+        elif sensor:
             sensors = [sensor]
         else:
             sensors = [""] if KIND[figure] in ("1", "angle") else list(SENSORS)
@@ -190,5 +221,13 @@ def _limits(pattern: str, value, sensor: str | None, key: str, where: str) -> li
             symmetric = False
             if low is not None and high is not None and low > high:
                 raise InputError(f"{literal(key)}: min is above max", where)
-        out += [Limit(figure, s, low, high, unit, symmetric) for s in matching]
+        offset = 0.0
+        if figure.startswith("scale_"):
+            if unit.strip() in ("%", "ppm"):  # a deviation from 1
+                offset = 1.0
+                low, high = (None if low is None else 1.0 + low), (None if high is None else 1.0 + high)
+            elif not ((low is None or low <= 1.0) and (high is None or high >= 1.0)):
+                raise InputError(f"{literal(key)}: its range excludes 1, and a scale is near 1; write e.g. "
+                                 "{ min = 0.995, max = 1.005 } or { abs_max = \"0.5 %\" } (a deviation from 1)", where)
+        out += [Limit(figure, s, low, high, unit, symmetric, key, offset) for s in matching]
     return out

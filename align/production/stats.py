@@ -5,16 +5,25 @@ For each figure (and sensor) over the units that gave it:
 * count, mean, standard deviation (``ddof = 1``), min, max, median;
 * process capability ``Cpk = min(USL - mean, mean - LSL) / (3 s)`` (one-sided: the side with a limit),
   with its standard error ``sqrt(1/(9n) + Cpk^2/(2(n-1)))`` (Bissell 1990);
-* the figure's yield: the fraction of units within its limit, with its binomial standard error;
-* outliers by the robust z-score ``z = 0.6745 (x - median) / MAD`` (Iglewicz and Hoaglin), ``|z| > 3.5``;
+* the figure's yield: the fraction of units within its limit;
+* outliers by the robust z-score ``z = 0.6745 (x - median) / MAD`` (Iglewicz and Hoaglin), ``|z| > 3.5``,
+  named only from :data:`OUTLIER_MIN_N` units on;
 * the trend: least-squares slope of the figure over the lot's order (per unit) or time (per day),
   with its standard error ``s_res / sqrt(sum (x - mean x)^2)``;
 * an individuals control chart: centre the mean, limits ``mean -/+ 3 MR/1.128`` (``MR`` the mean moving
   range in lot order), and the units outside them.
 
-A unit passes when it ran (status ok) and every figure it gave lies within every limit that applies
-to it (a figure its job does not give, or an Allan term its record could not identify, is not judged);
-the lot's yield is the units passing over all units, those that failed or errored included.
+Populations are never pooled across jobs or units: a figure's statistics are grouped by (job, sensor,
+the row's reading unit ``bias_unit``), so a calibration in counts is described in counts, apart from SI
+rows, and a matrix ``M`` is not pooled with a Ferraris or ``calibrate gyro`` one.
+
+A unit is a serial, judged by all its jobs' rows. It passes when every job ran (status ok) and every
+limit that applies to one of its sensors was checked and held. A limit is not checked for a unit when
+none of its rows gives the figure (a job that does not give it, an Allan term its record could not
+identify: NaN) or the figure is count-valued (a calibration in counts: an SI limit is not applied to
+it); such a unit's verdict is ``"unchecked"``, which is not a pass, and :attr:`LotStats.notes` states
+each limit left unchecked. The lot's yield is the units passing over all units, with its Wilson 95 %
+interval.
 
 Public names
 ------------
@@ -30,12 +39,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from align.production.figures import FIGURES, shown_unit
+from align.production.figures import FIGURES, KIND, shown_unit, si_unit
 from align.production.spec import Limit, Spec
 from align.units import to_unit
 
 #: the robust z-score beyond which a unit is an outlier (Iglewicz and Hoaglin)
 OUTLIER_Z = 3.5
+#: the fewest units from which outliers are named (a robust z of 3 units means little)
+OUTLIER_MIN_N = 8
+#: kinds of figure whose value is in counts on a row whose ``bias_unit`` is ``"count"``
+_COUNTED_KINDS = ("reading", "white", "flicker", "walk")
 #: figures described when no spec names any
 KEY_FIGURES = ("scale_*", "phi_*", "delta_*", "bias_?", "arw_*", "bi_*", "rrw_*", "field", "coverage", "heading_error")
 
@@ -109,6 +122,8 @@ class FigureStats:
     lcl: float
     ucl: float
     out_of_control: tuple
+    job: str = ""
+    reading_unit: str = ""
 
     @property
     def n(self) -> int:
@@ -120,14 +135,17 @@ class FigureStats:
         return self.passed / self.n if self.limit is not None and self.n else math.nan
 
     def shown(self, value: float) -> float:
-        """An SI value of this figure in :attr:`unit`."""
-        return float(to_unit(value, self.unit)) if self.unit != "1" else float(value)
+        """An SI value of this figure in :attr:`unit` (count-valued figures as they are)."""
+        return float(to_unit(value, self.unit)) if self.unit != "1" and not self.unit.startswith("count") \
+            else float(value)
 
 
 @dataclass(frozen=True)
 class UnitVerdict:
-    """A unit of the lot: ``verdict`` ``"pass"``, ``"fail"`` (outside a limit), ``"failed"`` (its job refused
-    it) or ``"error"``; ``reasons`` the limits it broke (``phi_xy = 0.31 deg: |phi_xy| <= 0.1 deg``) or its message."""
+    """A unit (serial) of the lot: ``verdict`` ``"pass"``, ``"unchecked"`` (a limit could not be checked),
+    ``"fail"`` (outside a limit), ``"failed"`` (a job refused it) or ``"error"``; ``job`` its jobs joined by
+    ``", "``; ``reasons`` the limits it broke (``phi_xy = 0.31 deg: |phi_xy| <= 0.1 deg``), left unchecked, or
+    its jobs' messages."""
 
     serial: str
     job: str
@@ -144,6 +162,7 @@ class LotStats:
     units: tuple
     trend_by: str
     spec: Spec | None
+    notes: tuple = ()
 
     @property
     def count(self) -> int:
@@ -158,9 +177,36 @@ class LotStats:
         return self.passed / self.count if self.count else math.nan
 
     @property
-    def yield_sigma(self) -> float:
-        p, n = self.yield_, self.count
-        return math.sqrt(p * (1 - p) / n) if n else math.nan
+    def yield_interval(self) -> tuple[float, float]:
+        """The Wilson score interval (95 %, ``z = 1.96``) of the yield:
+        ``(p + z^2/2n -/+ z sqrt(p(1-p)/n + z^2/4n^2)) / (1 + z^2/n)``."""
+        return wilson(self.passed, self.count)
+
+
+def wilson(k: int, n: int, z: float = 1.959964) -> tuple[float, float]:
+    """Wilson score interval of a proportion ``k / n`` (NaN for ``n = 0``)."""
+    if not n:
+        return math.nan, math.nan
+    p = k / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def counted(row: dict, figure: str) -> bool:
+    """True when ``figure`` of ``row`` is in counts (a calibration in counts: readings, noise terms, ``M``)."""
+    if (row.get("bias_unit") or "") != "count":
+        return False
+    return KIND[figure] in _COUNTED_KINDS or figure.startswith(("M_", "scale_"))
+
+
+def _group_unit(figure: str, sensor: str, reading_unit: str) -> str:
+    """The unit a figure of a (job, sensor, reading unit) group is shown in when no limit states one."""
+    if reading_unit != "count" or not (KIND[figure] in _COUNTED_KINDS or figure.startswith(("M_", "scale_"))):
+        return shown_unit(figure, sensor)
+    if KIND[figure] in _COUNTED_KINDS:
+        return "count"
+    return f"count/({si_unit('field' if sensor == 'magnetometer' else 'bias_x', sensor)})"
 
 
 def _violations(row: dict, spec: Spec | None) -> list[str]:
@@ -169,7 +215,8 @@ def _violations(row: dict, spec: Spec | None) -> list[str]:
         return out
     for lim in spec.limits:
         v = row.get(lim.figure)
-        if lim.applies(row.get("sensor")) and isinstance(v, float) and math.isfinite(v) and not lim.ok(v):
+        if (lim.applies(row.get("sensor")) and isinstance(v, float) and math.isfinite(v) and not counted(row, lim.figure)
+                and not lim.ok(v)):
             u = "" if lim.unit == "1" else f" {lim.unit}"
             out.append(f"{lim.figure} = {_beside(lim.shown(v), lim)}{u}, outside {lim.describe()}")
     return out
@@ -221,16 +268,30 @@ def _figure_names(rows: list[dict], spec: Spec | None) -> list[tuple[str, str]]:
     return [(f, s) for s in sensors for f in names]
 
 
-def _figure(rows: list[dict], figure: str, sensor: str, spec: Spec | None, xs: dict) -> FigureStats | None:
+def _groups(rows: list[dict], figure: str, sensor: str) -> list[tuple[str, str]]:
+    """The (job, reading unit) populations of ``figure`` for ``sensor``: never pooled with one another."""
+    out: list[tuple[str, str]] = []
+    for r in rows:
+        if r.get("status") == "ok" and r.get("sensor") == sensor and isinstance(r.get(figure), float) \
+                and math.isfinite(r[figure]):
+            key = (r.get("job") or "", r.get("bias_unit") or "")
+            if key not in out:
+                out.append(key)
+    return out
+
+
+def _figure(rows: list[dict], figure: str, sensor: str, spec: Spec | None, xs: dict, job: str = "",
+            reading_unit: str = "") -> FigureStats | None:
     got = [(r["serial"], xs[id(r)], r[figure]) for r in rows
            if r.get("status") == "ok" and r.get("sensor") == sensor and isinstance(r.get(figure), float)
-           and math.isfinite(r[figure])]
+           and math.isfinite(r[figure]) and (r.get("job") or "") == job and (r.get("bias_unit") or "") == reading_unit]
     if not got:
         return None
     serials = tuple(g[0] for g in got)
     x, v = np.array([g[1] for g in got], float), np.array([g[2] for g in got], float)
-    limits = spec.limits_for(figure, sensor) if spec is not None else []
-    lim = limits[0] if limits else None
+    in_counts = counted({"bias_unit": reading_unit}, figure)
+    limits = spec.limits_for(figure, sensor) if spec is not None and not in_counts else []
+    lim = limits[0] if limits else None  # one at most: read_spec refuses overlapping limits
     c, cs = cpk(v, lim.low, lim.high) if lim else (math.nan, math.nan)
     z = robust_z(v)
     slope, slope_s = trend(x, v)
@@ -239,11 +300,32 @@ def _figure(rows: list[dict], figure: str, sensor: str, spec: Spec | None, xs: d
     sigma = float(np.mean(mr)) / 1.128 if len(mr) else math.nan
     mean = float(np.mean(v))
     lcl, ucl = mean - 3 * sigma, mean + 3 * sigma
-    return FigureStats(figure, sensor, lim, lim.unit if lim else shown_unit(figure, sensor), serials, x, v, mean,
+    outliers = tuple(s for s, zz in zip(serials, z) if abs(zz) > OUTLIER_Z) if len(v) >= OUTLIER_MIN_N else ()
+    unit = lim.unit if lim else _group_unit(figure, sensor, reading_unit)
+    return FigureStats(figure, sensor, lim, unit, serials, x, v, mean,
                        float(np.std(v, ddof=1)) if len(v) > 1 else math.nan, float(v.min()), float(v.max()),
                        float(np.median(v)), c, cs, int(sum(lim.ok(a) for a in v)) if lim else 0,
-                       tuple(s for s, zz in zip(serials, z) if abs(zz) > OUTLIER_Z), slope, slope_s, mean, lcl, ucl,
-                       tuple(s for s, a in zip(serials, v) if not lcl <= a <= ucl) if math.isfinite(sigma) else ())
+                       outliers, slope, slope_s, mean, lcl, ucl,
+                       tuple(s for s, a in zip(serials, v) if not lcl <= a <= ucl) if math.isfinite(sigma) else (),
+                       job, reading_unit)
+
+
+def _unchecked(rows: list[dict], spec: Spec | None) -> list[tuple[Limit, str]]:
+    """The limits that apply to a sensor of a unit's ``rows`` (all its jobs, status ok) but that none of them
+    checks: (limit, why)."""
+    if spec is None:
+        return []
+    out = []
+    sensors = {r.get("sensor") for r in rows if r.get("sensor")}
+    for lim in spec.limits:
+        mine = [r for r in rows if r.get("sensor") in sensors and lim.applies(r.get("sensor"))]
+        if not mine or (lim.sensor == "" and si_unit(lim.figure, mine[0]["sensor"]) is None):
+            continue
+        finite = [r for r in mine if isinstance(r.get(lim.figure), float) and math.isfinite(r[lim.figure])]
+        if any(not counted(r, lim.figure) for r in finite):
+            continue
+        out.append((lim, "in counts" if finite else "not given"))
+    return out
 
 
 def figures_needed(spec: Spec | None) -> list[str]:
@@ -275,20 +357,38 @@ def lot_statistics(rows: list[dict], spec: Spec | None = None, trend_by: str = "
               for r in rows}
     else:
         xs = {id(r): float(r["order"]) if r.get("order") is not None else math.nan for r in rows}
-    figures = tuple(f for f in (_figure(rows, fig, s, spec, xs) for fig, s in _figure_names(rows, spec)) if f)
-    units: dict[tuple, UnitVerdict] = {}
+    figures = tuple(f for f in (_figure(rows, fig, s, spec, xs, job, unit) for fig, s in _figure_names(rows, spec)
+                                for job, unit in _groups(rows, fig, s)) if f)
+    by_serial: dict[str, list[dict]] = {}
     for r in rows:
-        key = (r["serial"], r["job"])
-        prev = units.get(key)
-        if r.get("status") != "ok":
-            verdict, reasons = r.get("status") or "error", (r.get("message") or "",)
+        by_serial.setdefault(r["serial"], []).append(r)
+    units: list[UnitVerdict] = []
+    missing: dict[tuple, list[str]] = {}
+    for serial, mine in by_serial.items():
+        jobs = ", ".join(dict.fromkeys(r["job"] for r in mine))
+        order = min((r.get("order") or 0) for r in mine)
+        dead = [r for r in mine if r.get("status") != "ok"]
+        if dead:
+            verdict = "error" if any(r.get("status") == "error" for r in dead) else "failed"
+            several = len({r["job"] for r in mine}) > 1
+            reasons = tuple((f"{r['job']}: " if several else "") + (r.get("message") or "") for r in dead)
         else:
-            broken = tuple(_violations(r, spec))
-            verdict, reasons = ("fail", broken) if broken else ("pass", ())
-        if prev is not None:  # another sensor of the unit: the worse verdict, every reason
-            rank = ("pass", "fail", "failed", "error")
-            worse = max(prev.verdict, verdict, key=lambda v: rank.index(v) if v in rank else len(rank))
-            verdict, reasons = worse, prev.reasons + reasons
-        units[key] = UnitVerdict(r["serial"], r["job"], r.get("order") or 0, verdict, reasons)
-    ordered = sorted(units.values(), key=lambda u: (u.verdict == "pass", u.order, u.serial))
-    return LotStats(figures, tuple(ordered), trend_by, spec)
+            broken = tuple(b for r in mine for b in _violations(r, spec))
+            open_ = _unchecked(mine, spec)
+            for lim, why in open_:
+                missing.setdefault((lim.key or lim.figure, lim.figure, why), []).append(serial)
+            if broken:
+                verdict, reasons = "fail", broken
+            elif open_:
+                verdict = "unchecked"
+                reasons = tuple(f"{lim.figure} not checked ({why})" for lim, why in open_)
+            else:
+                verdict, reasons = "pass", ()
+        units.append(UnitVerdict(serial, jobs, order, verdict, reasons))
+    notes = tuple(f"limit {key} ({figure}) not checked for {len(who)} of {len(by_serial)} units: "
+                  + ("its figure is in counts (a calibration in counts): an SI limit is not applied to it" if why == "in counts"
+                     else "no job of theirs gives it (or it is NaN: not identifiable)")
+                  + f" (e.g. {', '.join(who[:3])}); they do not count as passing"
+                  for (key, figure, why), who in missing.items())
+    ordered = sorted(units, key=lambda u: (u.verdict == "pass", u.order, u.serial))
+    return LotStats(figures, tuple(ordered), trend_by, spec, notes)

@@ -93,9 +93,15 @@ def read_table(path: str | Path) -> pa.Table:
     if p.is_dir():
         raise InputError("is a folder; give the table's .parquet file", str(p))
     try:
-        return pq.read_table(p)
+        table = pq.read_table(p)
     except Exception as exc:  # pyarrow raises several types for a damaged or foreign file
         raise InputError(f"not a readable Parquet table ({' '.join(str(exc).split())[:200]})", str(p)) from None
+    fmt = (table.schema.metadata or {}).get(b"format", b"").decode(errors="replace")
+    lacking = [n for n in ("serial", "job", "time", "run", "status") if n not in table.column_names]
+    if fmt != SCHEMA.metadata[b"format"].decode() or lacking:
+        what = f"no column {lacking[0]}" if lacking else f"format '{fmt or 'none'}'"
+        raise InputError(f"not an imu-align lot table ({what}); give results.parquet of imu-align batch", str(p))
+    return table
 
 
 def append_rows(path: str | Path, rows: Iterable[dict], chunk: int = 256) -> int:
@@ -189,9 +195,28 @@ class Journal:
         if not self.path.exists():
             return 0
         with open(self.path, encoding="utf-8") as fh:
-            n = append_rows(self.table, _lines(fh))
+            n = append_rows(self.table, _fresh(self.table, _lines(fh)))
         self.path.unlink()
         return n
+
+
+def _key(row: dict) -> tuple:
+    """A row's identity: one unit's job, sensor and run."""
+    return (row.get("serial"), row.get("job"), row.get("run"), row.get("sensor"))
+
+
+def _fresh(table: Path, rows: Iterable[dict]) -> Iterable[dict]:
+    """``rows`` less those the table (and the rows before them) already hold: folding a journal twice (a kill
+    between the table's rewrite and the journal's removal) adds nothing the second time."""
+    have = set()
+    if table.exists():
+        old = read_table(table).select(["serial", "job", "run", "sensor"]).to_pylist()
+        have = {_key(r) for r in old}
+    for r in rows:
+        k = _key(r)
+        if k not in have:
+            have.add(k)
+            yield r
 
 
 def _lines(fh) -> Iterable[dict]:

@@ -131,7 +131,7 @@ options = "--grid octave"
     assert alone.code == 0
     from align.results import load_result
 
-    ours, theirs = load_result(tmp_path / "out" / "units" / "A1.json"), load_result(tmp_path / "alone.json")
+    ours, theirs = load_result(tmp_path / "out" / "units" / "A1.calibrate-accel.json"), load_result(tmp_path / "alone.json")
     assert np.array_equal(ours.sensors["accelerometer"].M, theirs.sensors["accelerometer"].M)
 
 
@@ -194,7 +194,8 @@ def test_a_changed_input_or_option_runs_that_unit_again(small_lot, tmp_path, run
 
 @pytest.mark.parametrize("text, words", [
     ("serial,job,log,plan\nA1,matrix,a.csv,p.toml\nA1,matrix,b.csv,p.toml\n",
-     "manifest.csv: line 3, column serial: A1 is also the serial of line 2; give each unit its own"),
+     "manifest.csv: line 3, column serial: A1 with job matrix is also stated at line 2; give each (serial, job) "
+     "once"),
     ("serial,job,log,plan\nA1,matix,a.csv,p.toml\n",
      "manifest.csv: line 2, column job: unknown job 'matix' (did you mean matrix?)"),
     ("serial,job,log,plan\nA1,matrix,a.csv,\n", "manifest.csv: line 2, column plan: empty; the matrix job needs one"),

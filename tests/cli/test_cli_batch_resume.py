@@ -53,6 +53,6 @@ def test_a_rerun_after_killing_the_batch_halfway_finishes_the_remaining_units_on
     assert len(table) == n and table.serial.is_unique  # the killed run's rows were kept, none run twice
     assert set(table.serial[table.run == table.run.min()]) == done
     assert not journal.exists() and not (out / ".batch.lock").exists()
-    assert sorted(p.name for p in (out / "units").iterdir()) == sorted(f"{s}.json" for s in table.serial)
+    assert sorted(p.name for p in (out / "units").iterdir()) == sorted(f"{s}.matrix.json" for s in table.serial)
     res = run_cli("batch", lot.manifest, "--out", out)
     assert f"ran 0, skipped {n}" in res.out

@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import csv
-
 import numpy as np
 import pytest
 
+import align
 from align.cli.batch import simulate_lot_command
 from align.errors import InputError
+from align.production.rehearsal import read_truth
 from align.units import DEG
 
 
@@ -25,8 +25,9 @@ def test_a_lot_is_written_with_its_truth_and_its_bad_units(tmp_path, capsys):
     said = capsys.readouterr().out
     assert sorted(p.name for p in out.iterdir()) == ["manifest.csv", "plan.toml", "sessions", "truth.csv"]
     assert not [p for p in (tmp_path / "new").iterdir() if p.name != "lot"]  # no staging folder left
-    with open(out / "truth.csv") as fh:
-        truth = list(csv.DictReader(fh))
+    head, truth = read_truth(out / "truth.csv")  # its first line states format, version, convention and units
+    assert head["version"] == "1" and head["units"]["phi_"] == "rad" and "rows of M are sensor axes" in head["convention"]
+    assert head["generator"] == f"imu-align {align.__version__}"
     kinds = [r["kind"] for r in truth]
     assert len(truth) == 12 and kinds.count("out of spec") == 2 and kinds.count("wrong direction") == 2 \
         and kinds.count("nan rows") == 1

@@ -11,14 +11,15 @@ fixture would run the lot again on each worker.
 
 from __future__ import annotations
 
-import csv
 import math
+from pathlib import Path
 
 import numpy as np
 import pyarrow.parquet as pq
 from _lots import cli, make_lot
 from scipy import stats as sst
 
+from align.production.rehearsal import read_truth
 from align.units import DEG
 
 PHI_MAX = 0.1 * DEG
@@ -30,8 +31,9 @@ def _run_lot(folder):
     truth, spec = make_lot(folder)
     code, out, err = cli("batch", truth.manifest, "--workers", 2, "--out", folder / "out", "--spec", spec)
     table = pq.read_table(folder / "out" / "results.parquet").to_pandas().set_index("serial")
-    with open(truth.truth) as fh:
-        rows = {r["serial"]: r for r in csv.DictReader(fh)}
+    head, truth_rows = read_truth(truth.truth)
+    assert head["format"] == "imu-align.lot-truth" and head["units"]["M_"] == "1" and head["units"]["bias_"] == "rad/s"
+    rows = {r["serial"]: r for r in truth_rows}
     return {"truth": truth, "spec": spec, "code": code, "out": out, "err": err, "table": table, "rows": rows,
             "folder": folder}
 
@@ -128,7 +130,8 @@ def _check_cpk_and_yield_equal_a_direct_computation_from_the_truth(lot):
         assert abs(fs.mean - x.mean()) < 3 * x.std(ddof=1) / math.sqrt(n)
         assert abs(fs.yield_ - np.mean((x >= low) & (x <= high))) <= 2 / n
     yield_true = sum(_passes(truth[s]) for s in measured) / 200  # the 3 broken units count as not passing
-    assert abs(stats.yield_ - yield_true) <= max(2 / 200, 2 * stats.yield_sigma)
+    lo, hi = stats.yield_interval  # Wilson 95 %
+    assert lo - 2 / 200 <= yield_true <= hi + 2 / 200 and lo < stats.yield_ < hi
     assert stats.count == 200 and 0.9 < stats.yield_ < 1.0
 
 
@@ -149,6 +152,20 @@ def _check_lot_command_lists_failing_units_first_and_draws_the_report(lot, folde
         assert s in html
     for s in truth.serials("out of spec"):  # far outside the others: robust outliers
         assert s in out.split("outliers")[-1]
+
+
+def _check_the_example_spec_fails_exactly_the_bad_units(lot):
+    """examples/production/spec.toml goes with this rehearsal: every out-of-spec unit fails it (on phi), every good
+    unit passes it, the 3 broken ones do not pass (review 17, bug 11)."""
+    example = Path(__file__).resolve().parents[2] / "examples" / "production" / "spec.toml"
+    code, out, err = cli("lot", lot["folder"] / "out" / "results.parquet", "--spec", example)
+    truth = lot["truth"]
+    listed = out.split("units not passing")[1].split("\n\n")[0].splitlines()[1:]
+    verdicts = {line.split()[0]: line.split()[1] for line in listed}
+    assert code == 4 and set(verdicts) == set(truth.serials()) - set(truth.serials("good")), out
+    for s in truth.serials("out of spec"):
+        assert verdicts[s] == "fail" and "phi_" in out.split(s)[1].splitlines()[0]
+    assert "yield 195 of 200" in out
 
 
 def _check_a_rerun_with_nothing_changed_runs_only_the_failed_units(lot):
@@ -186,4 +203,5 @@ def test_a_lot_of_200_units_through_batch_and_lot_against_its_truth(tmp_path):
     for check in (_check_bad_units_are_reported_by_serial_with_the_single_command_s_message,
                   _check_lot_command_lists_failing_units_first_and_draws_the_report):
         check(lot, tmp_path / check.__name__)
+    _check_the_example_spec_fails_exactly_the_bad_units(lot)
     _check_a_rerun_with_nothing_changed_runs_only_the_failed_units(lot)

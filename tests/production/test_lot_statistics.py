@@ -19,7 +19,7 @@ from align.units import DEG
 def test_limits_are_parsed_in_their_units_and_patterns_expand(tmp_path):
     (tmp_path / "s.toml").write_text('''
 "phi_*" = { abs_max = "0.1 deg" }
-scale_x = { min = 0.995, max = "100.5 %" }
+scale_x = { min = 0.995, max = 1.005 }
 arw_x = { max = "0.3 deg/sqrt(h)" }
 bias_y = { abs_max = "0.05 m/s^2" }
 [magnetometer]
