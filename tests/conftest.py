@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+import subprocess
 import sys
 from pathlib import Path
 
@@ -66,3 +68,23 @@ def imu_align_command() -> list[str]:
     """The installed ``imu-align`` console script beside this Python (``python -m align.cli`` without one)."""
     script = Path(sys.executable).with_name("imu-align")
     return [str(script)] if script.exists() else [sys.executable, "-m", "align.cli"]
+
+
+def in_chromium(path, tmp_path, shot=None, size="1100,1800") -> str:
+    """Render ``path`` in headless Chromium: the DOM's title counts the images and the broken ones; no console error."""
+    page = path.read_text()
+    probe = ("<script>window.addEventListener('load',()=>{"
+             "const bad=[...document.images].filter(i=>!(i.complete&&i.naturalWidth>0));"
+             "document.title='images '+document.images.length+' broken '+bad.length;});</script></body>")
+    checked = tmp_path / "checked.html"
+    checked.write_text(page.replace("</body>", probe))
+    flags = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+             "--disable-background-networking", "--disable-component-update", "--disable-sync",
+             f"--user-data-dir={tmp_path / 'profile'}", "--enable-logging=stderr", "--v=0"]
+    res = subprocess.run(["chromium", *flags, "--virtual-time-budget=5000", "--dump-dom", checked.as_uri()],
+                         capture_output=True, text=True, timeout=120)
+    assert "CONSOLE" not in res.stderr and "Uncaught" not in res.stderr
+    if shot is not None:
+        subprocess.run(["chromium", *flags, f"--window-size={size}", f"--screenshot={shot}", path.as_uri()],
+                       capture_output=True, timeout=120)
+    return re.search(r"<title>(.*?)</title>", res.stdout).group(1)

@@ -5,7 +5,6 @@ import subprocess
 import sys
 
 import numpy as np
-import pytest
 from conftest import truth_model, write_session
 
 from align.alignment.plan import Plan, Step

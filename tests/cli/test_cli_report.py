@@ -7,11 +7,10 @@ import io
 import json
 import re
 import shutil
-import subprocess
 
 import numpy as np
 import pytest
-from conftest import ROOT, SHARED, write_session
+from conftest import ROOT, SHARED, in_chromium, write_session
 from scipy.spatial.transform import Rotation
 
 from align.alignment.plan import Plan
@@ -51,26 +50,6 @@ def pictures(page: str) -> list:
 
 def sections(page: str) -> list[str]:
     return re.findall(r"<h2>(.*?)</h2>", page)
-
-
-def in_chromium(path, tmp_path, shot=None) -> str:
-    """Render ``path`` in headless Chromium: the DOM's title counts the images and the broken ones; no console error."""
-    page = path.read_text()
-    probe = ("<script>window.addEventListener('load',()=>{"
-             "const bad=[...document.images].filter(i=>!(i.complete&&i.naturalWidth>0));"
-             "document.title='images '+document.images.length+' broken '+bad.length;});</script></body>")
-    checked = tmp_path / "checked.html"
-    checked.write_text(page.replace("</body>", probe))
-    flags = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-             "--disable-background-networking", "--disable-component-update", "--disable-sync",
-             f"--user-data-dir={tmp_path / 'profile'}", "--enable-logging=stderr", "--v=0"]
-    res = subprocess.run(["chromium", *flags, "--virtual-time-budget=5000", "--dump-dom", checked.as_uri()],
-                         capture_output=True, text=True, timeout=120)
-    assert "CONSOLE" not in res.stderr and "Uncaught" not in res.stderr
-    if shot is not None:
-        subprocess.run(["chromium", *flags, "--window-size=1100,1800", f"--screenshot={shot}", path.as_uri()],
-                       capture_output=True, timeout=120)
-    return re.search(r"<title>(.*?)</title>", res.stdout).group(1)
 
 
 browser = pytest.mark.skipif(shutil.which("chromium") is None, reason="Chromium not installed (CI installs it)")

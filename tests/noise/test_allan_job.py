@@ -201,7 +201,8 @@ def test_an_unidentified_random_walk_is_stated_as_its_upper_bound_in_json_and_ka
     from align.units import parse_quantity, to_unit
 
     fs = 100.0
-    x = simulate_noise(int(0.03 * 3600 * fs), fs, NoiseSpec(white=parse_quantity("0.3 deg/sqrt(h)", "angle_random_walk")), 3, seed=4)
+    white = parse_quantity("0.3 deg/sqrt(h)", "angle_random_walk")
+    x = simulate_noise(int(0.03 * 3600 * fs), fs, NoiseSpec(white=white), 3, seed=4)
     np.save(tmp_path / "s.npy", to_unit(x, "deg/s"))
     out, yml = tmp_path / "a.json", tmp_path / "imu.yaml"
     assert run(["allan", str(tmp_path / "s.npy"), "--rate-hz", "100", "--json", str(out)]) == 0

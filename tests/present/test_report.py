@@ -11,6 +11,7 @@ import sys
 
 import numpy as np
 import pytest
+from conftest import in_chromium
 
 
 @pytest.fixture(scope="module")
@@ -54,23 +55,8 @@ def test_report_is_self_contained_and_every_picture_decodes(demo_dir):
 
 @pytest.mark.skipif(shutil.which("chromium") is None, reason="Chromium not installed (CI installs it)")
 def test_report_in_headless_chromium(demo_dir, tmp_path):
-    page = (demo_dir[0] / "report.html").read_text()
-    probe = ("<script>window.addEventListener('load',()=>{"
-             "const bad=[...document.images].filter(i=>!(i.complete&&i.naturalWidth>0));"
-             "document.title='images '+document.images.length+' broken '+bad.length;});</script></body>")
-    checked = tmp_path / "checked.html"
-    checked.write_text(page.replace("</body>", probe))
-    flags = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-             "--disable-background-networking", "--disable-component-update", "--disable-sync",
-             f"--user-data-dir={tmp_path / 'profile'}", "--enable-logging=stderr", "--v=0"]
-    res = subprocess.run(["chromium", *flags, "--virtual-time-budget=5000", "--dump-dom", checked.as_uri()],
-                         capture_output=True, text=True, timeout=120)
-    assert "<title>images 4 broken 0</title>" in res.stdout
-    assert "CONSOLE" not in res.stderr and "Uncaught" not in res.stderr
     shot = tmp_path / "shot.png"
-    page_uri = (demo_dir[0] / "report.html").as_uri()
-    subprocess.run(["chromium", *flags, "--window-size=1100,2000", f"--screenshot={shot}", page_uri],
-                   capture_output=True, timeout=120)
+    assert in_chromium(demo_dir[0] / "report.html", tmp_path, shot, "1100,2000") == "images 4 broken 0"
     from PIL import Image
 
     img = np.asarray(Image.open(shot).convert("L"))
