@@ -52,7 +52,8 @@ def batch_summary(run, manifest: str, where: str, table_path, seconds: float) ->
     ran = run.units()
     ok, outside = run.lot("ok"), run.lot("ok", "fail")
     failed, errors = run.lot("failed"), run.lot("error")
-    lines = [f"batch of {manifest} on {where}: {run.total} unit{'s' if run.total != 1 else ''}; ran {len(ran)}, skipped {len(run.lot()) - len(ran)} "
+    units = f"{run.total} unit{'s' if run.total != 1 else ''}"
+    lines = [f"batch of {manifest} on {where}: {units}; ran {len(ran)}, skipped {len(run.lot()) - len(ran)} "
              f"(done before, inputs unchanged); {len(ok)} ok" + (f" ({len(outside)} outside the spec)" if outside else "")
              + f", {len(failed)} failed, {len(errors)} errors",
              f"{seconds:.1f} s" + (f", {len(ran) / seconds:.2f} units/s" if ran and seconds > 0 else "")
