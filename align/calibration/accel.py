@@ -9,7 +9,7 @@ The accelerometer shares the alignment convention ``raw = M true + bias``
   optionally the Ferraris pairwise bias ``b_i = (a_i(+i up) + a_i(-i up)) / 2``.
 * Unknown orientations (imu_tk style): ``|U (a_k - b)| = g`` over many static
   attitudes, ``U`` upper triangular (the sensor-to-case rotation is not
-  observable), ``M = U^-1``.
+  observable), ``M = U^-1`` (:mod:`align.calibration.accelfree`, re-exported here).
 * A session (:func:`accel_session`): the static means of a log's positions,
   then one of the two fits.
 
@@ -28,6 +28,7 @@ import numpy as np
 from align.alignment.estimate import fit_lsq
 from align.alignment.observe import Observation
 from align.alignment.segment import Segment
+from align.calibration.accelfree import calibrate_accel_free
 from align.calibration.positions import parse_positions, positions_of
 from align.calibration.results import Calibration
 from align.calibration.statics import static_intervals
@@ -201,7 +202,7 @@ def accel_session(t: np.ndarray, a: np.ndarray, intervals: list, positions: list
         ranges = {f"interval {k + 1}": r for k, r in enumerate(intervals)}
         check_at_rest(norms_at_rest(a, ranges), gravity, units, "units", where)
         means = static_means(a, ranges, 0.02, f"{where}: ")
-        cal = calibrate_accel_free(np.array(list(means.values())), gravity, units)
+        cal = calibrate_accel_free(np.array(list(means.values())), gravity, units, where=where)
         note = f"{len(intervals)} static intervals detected automatically (moving variance)"
         return cal.replace(notes=cal.notes + (note,))
     parsed = parse_positions(positions, positions_file)
@@ -302,88 +303,3 @@ def calibrate_accel(means: dict, ups: dict, gravity: float = STANDARD_GRAVITY, u
     checks = {k: means[k] - (m @ (gravity * np.asarray(ups[k])) + b) for k in holdout}
     return Calibration("accelerometer", m, b, fit.sigma_M, fit.sigma_bias, units, "multi-position least squares",
                        residuals, checks, tuple(notes))
-
-
-def calibrate_accel_free(means: np.ndarray, gravity: float = STANDARD_GRAVITY, units: str = "m/s^2",
-                         guess_scale: float | None = None, guess_bias=None) -> Calibration:
-    """Accelerometer from static attitudes of unknown orientation: ``|U (a_k - b)| = g`` (imu_tk's idea).
-
-    ``U`` is upper triangular (x along the accelerometer's x axis, y in its x-y
-    plane: the rotation to the case is not observable), ``M = U^-1``. Solved by
-    Levenberg-Marquardt (scipy) from a sphere guess; the 1-sigma come from the
-    Jacobian and the residual variance.
-
-    Parameters
-    ----------
-    means : ndarray, shape (k, 3)
-        Mean reading of each static attitude, SI or counts; ``k >= 9``.
-    gravity : float
-        Local gravity, m/s^2.
-    units : str
-        Unit of the readings, for the result's file form.
-    guess_scale : float, optional
-        Starting scale (readings per m/s^2); default from the spread of ``means``.
-    guess_bias : array_like, shape (3,), optional
-        Starting bias; default the mean of ``means``.
-
-    Returns
-    -------
-    Calibration
-        Residuals are ``|a| - g`` per attitude, in readings, on the x component.
-    """
-    from scipy.optimize import least_squares
-
-    a = np.asarray(means, float)
-    gravity = check_gravity(gravity)
-    check_at_rest(np.linalg.norm(a, axis=1), gravity, units)
-    k = len(a)
-    if k < 9:
-        raise InputError(f"only {k} static attitudes; the 9-parameter fit needs at least 9 (12 or more recommended)",
-                         "static intervals")
-    centre = a.mean(axis=0) if guess_bias is None else np.asarray(guess_bias, float)
-    spread = np.linalg.svd(a - centre, compute_uv=False)
-    if spread[-1] < 0.05 * spread[0]:
-        raise TestError("the static attitudes lie nearly in a plane: turn the sensor through all directions", "static intervals")
-    scale = np.median(np.linalg.norm(a - centre, axis=1)) / gravity if guess_scale is None else guess_scale
-    iu = np.triu_indices(3)
-
-    def unpack(p):
-        u = np.zeros((3, 3))
-        u[iu] = p[:6]
-        return u, p[6:]
-
-    x0 = np.zeros(9)
-    x0[[0, 3, 5]] = 1.0 / scale  # the diagonal of U in triu order (0,0), (1,1), (2,2)
-    x0[6:] = centre
-
-    def resid(p):
-        u, b = unpack(p)
-        return np.linalg.norm((a - b) @ u.T, axis=1) - gravity
-
-    sol = least_squares(resid, x0, method="lm", x_scale="jac")
-    u, b = unpack(sol.x)
-    # |U v| = |D U v| for D = diag(+/-1): the sign of each row of U is not observable; take the positive diagonal
-    # (each axis reads +g along itself), so a flipped axis cannot be seen here: only known orientations show it
-    u = np.diag(np.where(np.diag(u) < 0, -1.0, 1.0)) @ u
-    if not np.all(np.isfinite(u)) or np.linalg.cond(u) > 1e8:
-        raise TestError("the fit is degenerate (a singular matrix): turn the sensor through all directions",
-                        "static intervals")
-    m = np.linalg.inv(u)
-    dof = max(k - 9, 1)
-    s2 = float(np.sum(sol.fun**2)) / dof
-    # columns scaled to unit norm first: in raw counts U (~1e-4) and b (~1e3) differ by 1e7, and an unscaled
-    # pseudo-inverse would drop the small directions (a bias sigma 500x too small)
-    norms = np.linalg.norm(sol.jac, axis=0)
-    norms[norms == 0] = 1.0
-    js = sol.jac / norms
-    cov = np.linalg.pinv(js.T @ js) / np.outer(norms, norms) * s2
-    # 1-sigma of M = U^-1 by first-order propagation dM = -M dU M
-    sig_u = np.zeros((3, 3))
-    sig_u[iu] = np.sqrt(np.diag(cov)[:6])
-    sigma_m = np.sqrt((np.abs(m) ** 2) @ (sig_u**2) @ (np.abs(m) ** 2))
-    per = float(np.mean(np.diag(m)))  # residuals of |a| (m/s^2) expressed in readings
-    resid_norm = {f"attitude {i + 1}": np.array([r * per, 0.0, 0.0]) for i, r in enumerate(sol.fun)}
-    note = (f"|a| = g fit over {k} static attitudes (local gravity {gravity:.6g} m/s^2); U upper triangular: "
-            f"the accelerometer-to-case rotation is not observable; rms |a| residual {np.sqrt(np.mean(sol.fun**2)):.3g} m/s^2")
-    return Calibration("accelerometer", m, b, sigma_m, np.sqrt(np.diag(cov)[6:]), units, "|a| = g fit (unknown attitudes)",
-                       resid_norm, {}, (note,))

@@ -5,14 +5,16 @@ free rotations about varied axes (by hand or on a simple fixture). The steps:
 
 1. Static poses: the moving-variance detector (:func:`align.calibration.statics.static_intervals`)
    with its threshold ``factor`` times the variance of the initial static period (imu_tk's
-   ``T_init``; its length detected when not given), or poses given as sample ranges.
+   ``T_init``; when not given, the shorter of the accelerometer's and the gyro's rest at the start;
+   pose 1 ends with it), or poses given as sample ranges.
 2. Accelerometer ``[M | b]`` from ``|a| = g`` over the poses' means
    (:func:`align.calibration.accel.calibrate_accel_free`): ``M_a`` upper triangular, which fixes the
    accelerometer frame ``c`` (x along the accelerometer's x axis, y in its x-y plane).
 3. Gyro bias: the mean over the initial static period (pose 1), Earth's rate ignored.
 4. Gyro ``M`` (``g = M w + b``, 9 parameters) by least squares on the gravity directions after
    integrating each rotation (:mod:`align.calibration.gyrofit`, equation G1), with 1-sigma,
-   residual per rotation and observability.
+   residual per rotation (the table :attr:`Calibration.rotations`) and observability; a gyro
+   mirrored relative to the accelerometer (``det M < 0``) is refused, a turned one noted.
 
 The gyro's ``M`` is relative to frame ``c``: gravity gives no reference about the vertical, so the
 case or system axes are not observed (:mod:`align.calibration.gyroframe` turns both sensors into
@@ -21,7 +23,7 @@ period); rotation ``k`` goes from pose ``k`` to pose ``k + 1``.
 
 Public names
 ------------
-RotationReport, GyroSession, calibrate_gyro_session, SINGULAR_CONDITION, METHOD
+RotationReport, GyroSession, calibrate_gyro_session, detect_poses, SINGULAR_CONDITION, METHOD
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from align.calibration.accel import StaticDetector, calibrate_accel_free
+from align.calibration.accelfree import widened_level
 from align.calibration.gyrochecks import (
     MIN_POSES,
     RECOMMENDED_POSES,
@@ -47,7 +50,7 @@ from align.calibration.statics import common_intervals, initial_static_period, s
 from align.errors import InputError, TestError
 from align.io import check_log
 from align.io.export import matrix_unit
-from align.plausible import check_at_rest, check_gravity, check_scale_factors, check_usable_model
+from align.plausible import check_at_rest, check_gravity, check_usable_model, scale_outside
 from align.units import DEG, STANDARD_GRAVITY
 from align.values import Value
 
@@ -127,24 +130,32 @@ class GyroSession(Value):
         return {"accelerometer": self.accelerometer, "gyroscope": self.gyroscope}
 
 
-def _poses(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, fs: float, detector: StaticDetector, intervals,
-           where: str) -> tuple:
-    """The poses: given, or where the accelerometer's moving variance stays below ``factor`` times its variance
+def detect_poses(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, fs: float, detector: StaticDetector, intervals,
+                 where: tuple[str, str] = ("log", "log")) -> tuple[list, float, str]:
+    """The poses (sample ranges, end exclusive), the initial static period (s) and how they were found: given
+    (``intervals``), or where the accelerometer's moving variance stays below ``factor`` times its variance
     over the initial static period (imu_tk) and the gyro's below ``gyro_factor`` times its own (the gyro sees the
-    slow start or end of a turn about a nearly vertical axis, which leaves the accelerometer almost unchanged)."""
+    slow start or end of a turn about a nearly vertical axis, which leaves the accelerometer almost unchanged).
+
+    The initial static period (``T_init``), when not given, is the shorter of the two sensors' (a first turn
+    about the vertical leaves the accelerometer still: its ``T_init`` alone runs into the turn); pose 1 ends
+    with it, so the gyro bias is its mean over rest only. ``where``: the gyro's and the accelerometer's logs."""
     if intervals is not None:
         return parse_intervals(intervals, len(t)), float("nan"), "given"
     d = detector
-    init = d.init_static_s or initial_static_period(acc, fs, d.window_s, d.factor, d.min_static_s, where)
+    init = d.init_static_s or min(initial_static_period(acc, fs, d.window_s, d.factor, d.min_static_s, where[1]),
+                                  initial_static_period(gyr, fs, d.window_s, d.factor, d.min_static_s, where[0]))
     poses = common_intervals(static_intervals(acc, fs, d.window_s, d.factor, init, d.min_static_s),
                              static_intervals(gyr, fs, d.window_s, d.gyro_factor, init, d.min_static_s),
                              int(np.ceil(d.min_static_s * fs)))
     w = max(3, int(round(d.window_s * fs)))
     if not poses or poses[0][0] > w:
         raise TestError(f"the initial static period ({init:g} s) is not at rest: the detector finds motion in its first "
-                        "window; record it at rest, or shorten {init_static_s}", where)
+                        "window; record it at rest, or shorten {init_static_s}", where[0])
+    poses[0] = (poses[0][0], min(poses[0][1], max(poses[0][0] + 1, int(round(init * fs)))))
+    source = "given" if d.init_static_s else "the shorter of the two sensors' rests at the start"
     how = (f"detected automatically (moving variance over {d.window_s:g} s below {d.factor:g} x the accelerometer's "
-           f"and {d.gyro_factor:g} x the gyro's variance over the initial {init:.1f} s)")
+           f"and {d.gyro_factor:g} x the gyro's variance over the initial {init:.1f} s, {source}; pose 1 ends with it)")
     return poses, float(init), how
 
 
@@ -165,7 +176,7 @@ def _observability(fit: GyroFit, where: str) -> tuple[int | None, str]:
 def calibrate_gyro_session(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, acc_units: str, gyr_units: str,
                            gravity: float = STANDARD_GRAVITY, detector: StaticDetector = StaticDetector(),
                            intervals=None, gyro_range: float | None = None, drop: tuple = (),
-                           g_sensitivity: bool = False, where: str = "log") -> GyroSession:
+                           g_sensitivity: bool = False, where: str = "log", accel_where: str | None = None) -> GyroSession:
     """Calibrate the accelerometer and the gyro of a multi-position session (steps 1-4 of the module).
 
     Parameters
@@ -191,6 +202,8 @@ def calibrate_gyro_session(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, acc_
         pose's mean reading, ``K_ga f(t)`` removed before integrating. Off: imu_tk's bias from pose 1.
     where : str
         The log, for messages.
+    accel_where : str, optional
+        The accelerometer's log when it is another file (its problems name it); default ``where``.
 
     Returns
     -------
@@ -200,18 +213,20 @@ def calibrate_gyro_session(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, acc_
     ------
     TestError
         Too few poses, a pose too short or not static, a rotation at the gyro's range, rotations that do
-        not span 3-D, readings that are not gravity or rates in the units given, ``det M <= 0``.
+        not span 3-D, readings that are not gravity or rates in the units given, scale factors no
+        accelerometer or gyro has, a gyro mirrored relative to the accelerometer (``det M < 0``).
     """
     t, acc, gyr = (np.asarray(x, float) for x in (t, acc, gyr))
-    check_log(t, acc, where)
+    acc_where = where if accel_where is None else accel_where
+    check_log(t, acc, acc_where)
     check_log(t, gyr, where)
     gravity = check_gravity(gravity)
     fs = 1.0 / float(np.median(np.diff(t)))
-    poses, init_s, how = _poses(t, acc, gyr, fs, detector, intervals, where)
+    poses, init_s, how = detect_poses(t, acc, gyr, fs, detector, intervals, (where, acc_where))
     check_poses(t, poses, detector.min_static_s, where)
-    means = check_static(t, acc, poses, where)
-    check_at_rest(np.linalg.norm(means, axis=1), gravity, acc_units, "accel_units", where)
-    acc_cal = calibrate_accel_free(means, gravity, acc_units)
+    means = check_static(t, acc, poses, acc_where)
+    check_at_rest(np.linalg.norm(means, axis=1), gravity, acc_units, "accel_units", acc_where)
+    acc_cal = calibrate_accel_free(means, gravity, acc_units, where=acc_where, fields=("accel_units", "accel_columns"))
     var_means = np.array([acc[a:b].var(axis=0) / (b - a) for a, b in poses])
     dirs, dir_cov = direction_covariance(means, var_means, acc_cal.M, acc_cal.bias)
     a0, b0 = poses[0]
@@ -232,8 +247,7 @@ def calibrate_gyro_session(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, acc_
     fit = fit_gyro_matrix(t, gyr - off.removed, spans, dirs, used, dir_cov=dir_cov, offsets=off.patterns,
                           offset_cov=off.cov)
     weak, seen = _observability(fit, where)
-    check_usable_model(fit.M, f"{where}: gyroscope")
-    check_scale_factors(fit.M, 0.2, gyr_units, "angular_rate", "gyro_units", where)
+    _check_gyro(fit.M, gyr_units, where)
     rotations = _reports(t, spans, fit, used)
     gyr_cal = _gyro_calibration(fit, off, gyr_units, rotations, poses, t, seen)
     pose_note = f"{len(poses)} static poses {how}"
@@ -243,6 +257,21 @@ def calibrate_gyro_session(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, acc_
     acc_cal = acc_cal.replace(notes=acc_cal.notes + (pose_note,))
     return GyroSession(acc_cal, gyr_cal, tuple(poses), tuple(rotations), fit.condition_number, weak,
                        fit.column_turn, init_s)
+
+
+def _check_gyro(m: np.ndarray, units: str, where: str) -> None:
+    """The gyro's ``M`` must be a gyro's: not mirrored relative to the accelerometer, usable, scale factors
+    within 1 +/- 0.2 (physical units)."""
+    det = float(np.linalg.det(m))
+    if np.isfinite(det) and det < 0:
+        raise TestError("gyro axes mirrored relative to the accelerometer (det M < 0): a column's sign or order is wrong "
+                        "in {gyro_columns} or {accel_columns}", where)
+    check_usable_model(m, f"{where}: gyroscope")
+    if matrix_unit(units, "gyroscope") == "1":
+        bad = scale_outside(m, 0.2)
+        if bad is not None:
+            raise TestError(f"the gyro's {'xyz'[bad[0]]} scale factor is {bad[1]:.3g}, outside 1 +/- 0.2: wrong "
+                            "{gyro_units} or {gyro_columns}, or a broken axis", where)
 
 
 def _reports(t: np.ndarray, spans: list, fit: GyroFit, used: np.ndarray) -> list[RotationReport]:
@@ -271,19 +300,46 @@ def _gyro_calibration(fit: GyroFit, off: _Offsets, units: str, rotations: list, 
         how = (f"bias and g-sensitivity K_ga (raw = M w + K_ga f + bias, f the specific force in m/s^2) from the "
                f"{len(poses)} poses' mean readings by least squares; rms pose residual {off.rms:.3g} (readings), "
                "Earth's rate not removed")
+    worst = max(used, key=lambda r: r.residual)
     notes = [FRAME_NOTE, how,
              f"M by least squares on the gravity directions after integrating {len(used)} rotations between "
-             f"{len(poses)} poses; rms residual {fit.rms / DEG:.3g} deg (largest {max(r.residual for r in used) / DEG:.3g} "
-             f"deg, rotation {max(used, key=lambda r: r.residual).number}); 1-sigma from the Jacobian and the residual "
-             f"variance ({fit.dof} degrees of freedom, widened {fit.widening:.3g}x for the t distribution)",
-             seen]
+             f"{len(poses)} poses; rms residual {fit.rms / DEG:.3g} deg (largest {worst.residual / DEG:.3g} deg, "
+             f"rotation {worst.number}); 1-sigma from the Jacobian and the residual variance ({fit.dof} degrees of "
+             f"freedom, widened {fit.widening:.3g}x for the t distribution) plus the accelerometer's and the bias's "
+             "noise propagated", seen, *_model_notes(fit, off)]
     left = [r.number for r in rotations if not r.used]
     if left:
         notes.append(f"rotations {', '.join(map(str, left))} left out of the fit (their residuals are checks)")
     notes.append("residual of rotation k: the mean reading error over the rotation that would explain the angle "
                  "between the predicted and the measured gravity direction")
+    level = widened_level(fit.widening, fit.dof, " for the residual part of M's covariance; the bias's is plain")
     return Calibration("gyroscope", fit.M, off.bias, fit.sigma_M, off.sigma_bias, units, METHOD, fitted, checks,
-                       tuple(notes), off.K)
+                       tuple(notes), off.K, level, tuple(_table(rotations, poses)))
+
+
+def _table(rotations: list, poses: list) -> list[dict]:
+    """The per-rotation table of the file (what the command prints): times, turn, axis, residual angle."""
+    return [{"rotation": r.number, "poses": [r.number, r.number + 1], "t_s": [round(r.t_start, 4), round(r.t_end, 4)],
+             "turn_deg": round(r.turn / DEG, 4), "axis": [round(float(v), 5) for v in r.axis],
+             "residual_deg": round(r.residual / DEG, 5), "used": r.used} for r in rotations]
+
+
+def _model_notes(fit: GyroFit, off: _Offsets) -> list[str]:
+    """What the fit says of the model: a gyro turned relative to the accelerometer, residuals beyond the noise."""
+    out = []
+    u, _, vt = np.linalg.svd(fit.M)
+    turn = float(np.degrees(np.arccos(np.clip((np.trace(u @ vt) - 1) / 2, -1, 1))))
+    if turn > 5.0:
+        out.append(f"the gyro's axes are turned by {turn:.3g} deg relative to the accelerometer's (two chips, or either "
+                   "sensor's columns in another order or sign: a mirrored accelerometer looks like a turned gyro, "
+                   "gravity alone cannot tell its handedness): M holds that rotation, in the accelerometer frame")
+    ratio = float(np.sqrt(fit.ssr / fit.noise_ssr)) if fit.noise_ssr > 0 else 0.0
+    if ratio > 3.0:
+        hint = ("" if off.K is not None else "; a g-sensitive gyro (Earth's gravity shifting its bias from pose to pose) "
+                "is the usual cause: try the g-sensitivity model (bias and K_ga from every pose)")
+        out.append(f"the residuals are {ratio:.3g}x (rms) what the sensors' noise explains: a model error or motion "
+                   f"within the poses, which the 1-sigma (from the residuals) includes{hint}")
+    return out
 
 
 @dataclass(frozen=True, eq=False)

@@ -12,10 +12,11 @@ where ``R_k(M)`` integrates the corrected rates ``w = M^-1 (g - b)`` over the ro
 :func:`align.attitude.integrate` (quaternions, fourth order) and ``P_k`` (2 x 3) projects on the
 plane normal to ``u_k+1`` (the third component of G1 is second order: each rotation gives two
 equations). ``M`` (9 parameters, ``g = M w + b``) minimises ``sum_k |r_k|^2`` (scipy's
-Levenberg-Marquardt), started from the best ``s I`` of a scan over the scale ``s`` (readings per
-rad/s: raw counts need no starting guess). The covariance is ``s^2 (J^T J)^-1`` with the residual
-variance ``s^2 = sum |r_k|^2 / (2K - 9)`` over ``K`` rotations, widened by ``t_(2K-9)(0.99865) / 3``
-so that 3 sigma holds its normal 99.73 % with few degrees of freedom.
+Levenberg-Marquardt), started from the best ``s P`` of a scan over the scale ``s`` (readings per
+rad/s: raw counts need no starting guess) and the 48 signed permutations ``P`` (a gyro turned
+or mirrored relative to the accelerometer; ``det M < 0`` is then reported by the caller). The
+covariance is ``s^2 (J^T J)^-1`` with the residual variance ``s^2 = sum |r_k|^2 / (2K - 9)`` over
+``K`` rotations, widened by ``t_(2K-9)(0.99865) / 3`` so that 3 sigma holds its normal 99.73 % with few degrees of freedom.
 
 Observability: column ``j`` of ``M`` is what the gyros read for a rotation about axis ``j``
 (reference section 1), so its residual derivatives scale with the turn about ``j``; a sequence that
@@ -24,7 +25,7 @@ column that dominates its weakest direction say so.
 
 Public names
 ------------
-GyroFit, fit_gyro_matrix, direction_covariance, tangent_basis, WEAK_CONDITION
+GyroFit, fit_gyro_matrix, direction_covariance, tangent_basis, signed_permutations, WEAK_CONDITION
 """
 
 from __future__ import annotations
@@ -68,6 +69,11 @@ class GyroFit:
         The column of ``M`` that dominates the Jacobian's weakest direction (0, 1, 2).
     rms : float
         RMS residual angle, rad.
+    ssr : float
+        ``sum |r_k|^2`` over the rotations used (G1), rad^2.
+    noise_ssr : float
+        What the propagated noise alone would give it: ``tr((I - J J^+) C)`` (``C`` of :func:`fit_gyro_matrix`);
+        ``ssr`` far above it is a model error (g-sensitivity, motion within the poses).
     """
 
     M: np.ndarray
@@ -81,6 +87,8 @@ class GyroFit:
     condition_number: float
     weak_column: int
     rms: float
+    ssr: float = float("nan")
+    noise_ssr: float = float("nan")
 
 
 def tangent_basis(u: np.ndarray) -> np.ndarray:
@@ -137,10 +145,42 @@ class _Problem:
         return out[self.used].reshape(-1, 3 * (k + 1))
 
 
+def signed_permutations() -> np.ndarray:
+    """The 24 rotations that map axes onto axes (signed permutation matrices of determinant +1), (24, 3, 3),
+    the identity first."""
+    from itertools import permutations, product
+
+    out = []
+    for perm in permutations(range(3)):
+        for signs in product((1.0, -1.0), repeat=3):
+            q = np.zeros((3, 3))
+            q[range(3), perm] = signs
+            if np.linalg.det(q) > 0:
+                out.append(q)
+    return np.array(out)
+
+
 def _start(problem: _Problem) -> np.ndarray:
-    """The best ``s I`` over the scale scan."""
-    costs = [float(np.sum(problem.resid((s * np.eye(3)).ravel()) ** 2)) for s in _SCAN]
-    return _SCAN[int(np.argmin(costs))] * np.eye(3)
+    """The best ``s P`` over the scale scan and the 48 signed permutations ``P`` (a gyro whose axes are turned
+    or mirrored relative to the accelerometer's: two chips, columns in another order or of another sign).
+
+    For a proper ``Q`` the rates ``(s Q)^-1 g = Q^T (g / s)`` turn the body by ``R_k(s Q) = Q^T R_k(s I) Q``
+    (``Q^T [v]x Q = [Q^T v]x``), and ``R_k(-s Q) = Q^T R_k(-s I) Q``: two integrations per scale serve all 48.
+    """
+    perms = signed_permutations()
+    u0, u1 = problem.dirs[:-1][problem.used], problem.dirs[1:][problem.used]
+    best = (np.inf, np.eye(3))
+    for s in _SCAN:
+        for sign in (1.0, -1.0):
+            r0 = problem.rotations(sign * s * np.eye(3))[problem.used]                  # (K, 3, 3)
+            r = np.einsum("pji,kjl,plm->pkim", perms, r0, perms)                         # Q^T R0 Q
+            v = np.einsum("pkji,kj->pki", r, u0) - u1                                    # R^T u_k - u_k+1
+            cost = (v ** 2).sum(axis=2) - np.einsum("pki,ki->pk", v, u1) ** 2            # |P_k v|^2
+            total = cost.sum(axis=1)
+            j = int(np.argmin(total))
+            if total[j] < best[0] * (1 - 1e-9):
+                best = (float(total[j]), sign * s * perms[j])
+    return best[1]
 
 
 def direction_covariance(means: np.ndarray, var_means: np.ndarray, m_a: np.ndarray, b_a: np.ndarray) -> tuple:
@@ -207,7 +247,7 @@ def fit_gyro_matrix(t: np.ndarray, g: np.ndarray, spans: list, dirs: np.ndarray,
     used : ndarray of bool, shape (K,), optional
         The rotations in the fit (all when not given); the others are integrated and reported only.
     m0 : ndarray, shape (3, 3), optional
-        Starting ``M``; default the best ``s I`` of a scan over the scale.
+        Starting ``M``; default the best ``s P`` of a scan over the scale and the signed permutations.
     dir_cov : ndarray, shape (3(K + 1), 3(K + 1)), optional
         Covariance of the stacked directions (:func:`direction_covariance`).
     offsets, offset_cov : ndarray, shapes (m, n, 3) and (m, m), optional
@@ -268,5 +308,6 @@ def fit_gyro_matrix(t: np.ndarray, g: np.ndarray, spans: list, dirs: np.ndarray,
         if u:
             column_turn += (w[a:b] * dt_mid[a:b, None]).sum(axis=0)
     ang = np.arctan2(np.linalg.norm(resid, axis=1), np.einsum("ki,ki->k", pred, problem.dirs[1:]))
+    noise_ssr = float(np.trace(extra) - np.trace(jac @ pinv @ extra))
     return GyroFit(m, sigma, resid, ang, turns, column_turn, dof, widening, cond, weak,
-                   float(np.sqrt(np.mean(ang[used] ** 2))))
+                   float(np.sqrt(np.mean(ang[used] ** 2))), float(np.sum(sol.fun ** 2)), noise_ssr)

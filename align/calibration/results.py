@@ -10,7 +10,7 @@ it also writes the pair as imucal's JSON (:meth:`CalibrationSet.as_imucal`).
 
 Public names
 ------------
-Calibration, CalibrationSet, SENSORS, SENSOR_KEYS, FORMAT, CONVENTION
+Calibration, CalibrationSet, SENSORS, SENSOR_KEYS, FORMAT, CONVENTION, PLAIN_LEVEL
 """
 
 from __future__ import annotations
@@ -34,7 +34,9 @@ CONVENTION = "raw = M true + bias; true = M^-1 (raw - bias); rows of M are senso
 SENSORS = ("accelerometer", "gyroscope")
 #: the keys of one sensor's calibration in the file (unknown keys are refused: a misspelled key is not ignored)
 SENSOR_KEYS = ("sensor", "method", "convention", "units", "M", "A", "bias", "uncertainty", "residuals", "checks", "notes",
-               "g_sensitivity")
+               "g_sensitivity", "rotations")
+#: the uncertainty level of a plain 1-sigma (a t-widened one says how it was widened)
+PLAIN_LEVEL = "1 sigma"
 
 
 @dataclass(frozen=True, eq=False)
@@ -61,6 +63,12 @@ class Calibration(Value):
     notes : tuple of str
     g_sensitivity : ndarray, shape (3, 3), optional
         Gyro ``K_ga``, (rad/s) per (m/s^2).
+    level : str
+        What the 1-sigma is (the file's ``uncertainty.level``): ``"1 sigma"``, or how it was widened for few
+        degrees of freedom (the t distribution's 99.73 % bound over 3).
+    rotations : tuple of dict
+        A gyro calibrated from rotations between poses: one row per rotation (``rotation``, ``poses``, ``t_s``,
+        ``turn_deg``, ``axis``, ``residual_deg``, ``used``), as written in the file; empty otherwise.
     """
 
     sensor: str
@@ -74,12 +82,15 @@ class Calibration(Value):
     checks: dict = field(default_factory=dict)
     notes: tuple = ()
     g_sensitivity: np.ndarray | None = None
+    level: str = PLAIN_LEVEL
+    rotations: tuple = ()
 
     def __post_init__(self) -> None:
         super().__post_init__()
         object.__setattr__(self, "residuals", {k: frozen_array(v) for k, v in self.residuals.items()})
         object.__setattr__(self, "checks", {k: frozen_array(v) for k, v in self.checks.items()})
         object.__setattr__(self, "notes", tuple(self.notes))
+        object.__setattr__(self, "rotations", tuple(dict(r) for r in self.rotations))
 
     def to_dict(self) -> dict:
         """The JSON form: matrices dimensionless, readings in ``self.units``."""
@@ -89,7 +100,7 @@ class Calibration(Value):
             "units": {"M": matrix_unit(u, self.sensor), "bias": u, "residuals": u},
             "M": self.M.tolist(), "A": np.linalg.inv(self.M).tolist(),
             "bias": to_unit(self.bias, u).tolist(),
-            "uncertainty": {"level": "1 sigma", "M": self.sigma_M.tolist(), "bias": to_unit(self.sigma_bias, u).tolist()},
+            "uncertainty": {"level": self.level, "M": self.sigma_M.tolist(), "bias": to_unit(self.sigma_bias, u).tolist()},
             "residuals": {k: to_unit(v, u).tolist() for k, v in self.residuals.items()},
             "checks": {k: to_unit(v, u).tolist() for k, v in self.checks.items()},
             "notes": list(self.notes),
@@ -97,6 +108,8 @@ class Calibration(Value):
         if self.g_sensitivity is not None:
             d["g_sensitivity"] = (self.g_sensitivity * to_unit(1.0, u)).tolist()
             d["units"]["g_sensitivity"] = f"{u} per m/s^2"
+        if self.rotations:
+            d["rotations"] = [dict(r) for r in self.rotations]
         return d
 
     @classmethod
@@ -120,6 +133,8 @@ class Calibration(Value):
                 checks={k: np.array(v, float) * f for k, v in d.get("checks", {}).items()},
                 notes=tuple(d.get("notes", [])),
                 g_sensitivity=kga,
+                level=str(unc.get("level", PLAIN_LEVEL)),
+                rotations=tuple(_rows(d.get("rotations", []), where)),
             )
         except (KeyError, TypeError, ValueError) as exc:
             raise InputError(f"malformed calibration ({malformed(exc)}); regenerate it", where) from None
@@ -140,6 +155,13 @@ class Calibration(Value):
         """
         off = self.bias if self.g_sensitivity is None or acc is None else self.bias + acc @ self.g_sensitivity.T
         return np.linalg.solve(self.M, (np.asarray(raw) - off).T).T
+
+
+def _rows(rows: object, where: str) -> list[dict]:
+    """The ``rotations`` table of a file: a list of objects."""
+    if not isinstance(rows, list) or not all(isinstance(r, dict) for r in rows):
+        raise InputError("malformed calibration: rotations must be a list of objects; regenerate it", where)
+    return rows
 
 
 class CalibrationSet(Result, format=FORMAT, convention=CONVENTION):

@@ -16,20 +16,31 @@ import typer
 from align.cli import options as opt
 from align.cli.options import DURATION, POSITIVE, names, split_columns
 from align.cli.paths import check_outputs, outputs
-from align.cli.simulate import Mounting
+from align.cli.simulate import MountingOption, parse_mounting_option
+
+#: ``--mounting`` of ``calibrate gyro`` (no plan here: none unless given)
+Mounting = Annotated[MountingOption | None, typer.Option(
+    "--mounting", parser=parse_mounting_option, metavar="MOUNTING",
+    help="Nominal mounting of the IMU, for the system frame: the system axis of the accelerometer's (and gyros') x, "
+         "y, z ('+y,-x,+z'), or a rotation ('30 deg about +z', '30 deg about 1,1,0'). Default: none (the "
+         "accelerometer frame).")]
 
 
-def rotation_table(session, units: str) -> str:
-    """The per-rotation lines of a :class:`~align.calibration.gyro.GyroSession`: times, turn, axis, residual."""
-    from align.units import DEG
-
+def rotation_table(rows) -> str:
+    """The per-rotation lines: times, turn, axis, residual; ``rows`` the calibration's rotation table
+    (:attr:`align.calibration.results.Calibration.rotations`, what the file holds)."""
     lines = ["rotations (residual: angle between the predicted and the measured gravity direction at the next pose):",
              "  rotation  poses      t [s]          turn [deg]  axis (accelerometer frame)  residual [deg]"]
-    for r in session.rotations:
-        axis = " ".join(f"{v:+.2f}" for v in r.axis)
-        left = "" if r.used else "  (left out: a check)"
-        lines.append(f"  {r.number:>8}  {r.number:>2}->{r.number + 1:<3}  {r.t_start:7.1f}-{r.t_end:<7.1f}  "
-                     f"{r.turn / DEG:9.1f}   {axis:<26}  {r.residual / DEG:9.3f}{left}")
+    for r in rows:
+        k, (t0, t1) = r["rotation"], r["t_s"]
+        axis = " ".join(f"{v:+.2f}" for v in r["axis"])
+        left = "" if r["used"] else "  (left out: a check)"
+        lines.append(f"  {k:>8}  {k:>2}->{k + 1:<3}  {t0:7.1f}-{t1:<7.1f}  {r['turn_deg']:9.1f}   {axis:<26}  "
+                     f"{r['residual_deg']:9.3f}{left}")
+    used = [r for r in rows if r["used"]]
+    if used:
+        big = max(used, key=lambda r: r["residual_deg"])
+        lines.append(f"  largest residual: rotation {big['rotation']}, {big['residual_deg']:.3g} deg")
     return "\n".join(lines)
 
 
@@ -44,13 +55,27 @@ def _split(text: str, rate_hz: float | None, field: str) -> tuple[str | None, li
 
 
 def _table_m(frame, where: str):
-    """``M`` of the rate-table result in ``frame`` (an alignment, or a calibration file's gyroscope)."""
+    """``M`` and its 1-sigma of the rate-table result in ``frame`` (an alignment, or a calibration file's gyroscope)."""
     from align.alignment.result import AlignmentResult
     from align.calibration import CalibrationSet
     from align.results import load_result
 
-    got = load_result(frame, (AlignmentResult, CalibrationSet))
-    return got.correction("gyroscope", where).M
+    got = load_result(frame, (AlignmentResult, CalibrationSet)).correction("gyroscope", where)
+    return got.M, got.sigma_M
+
+
+def _read(path, columns, units, time_col, rate_hz, fmt, field: str, columns_field: str, expect: str | None):
+    """One sensor's log, its missing columns named with that sensor's option."""
+    import align.io as fileio
+    from align.errors import InputError
+
+    try:
+        return fileio.read_sensor_log(path, columns, units, time_col, rate_hz, expect=expect, log_format=fmt,
+                                      counts=True, field=field)
+    except InputError as exc:
+        if "{columns}" not in exc.message:
+            raise
+        raise InputError(exc.message.replace("{columns}", "{" + columns_field + "}"), exc.where) from None
 
 
 def gyro(
@@ -94,7 +119,8 @@ def gyro(
                         "RESULT.json") = None,
     mounting: Mounting = None,
     json_out: opt.JsonOut = None,
-    plot: opt.OptInput("--plot", "Picture of the static poses found (PNG).", "POSES.png") = None,
+    plot: opt.OptInput("--plot", "Picture of the session calibrated: |a| over the poses, |w| over the rotations with "
+                       "their turn and residual (PNG).", "SESSION.png") = None,
     skip_rows: opt.SkipRows = 0,
     comment: opt.Comment = None,
     delimiter: opt.Delimiter = None,
@@ -108,7 +134,6 @@ def gyro(
     check_outputs([log, accel_log, frame], json_out=json_out, plot=plot)
     import numpy as np
 
-    import align.io as fileio
     from align.calibration import CalibrationSet, StaticDetector
     from align.calibration.gyro import calibrate_gyro_session
     from align.calibration.gyroframe import in_system_frame
@@ -120,17 +145,15 @@ def gyro(
         raise InputError("give the system frame once: a rate-table result or a mounting", "{frame}")
     fmt = opt.log_format(skip_rows, comment, delimiter, time_units)
     time_col, gcols = _split(gyro_columns, rate_hz, "gyro_columns")
-    gyr = fileio.read_sensor_log(log, gcols, gyro_units, time_col, rate_hz, log_format=fmt, counts=True,
-                                 field="gyro_units")
+    gyr = _read(log, gcols, gyro_units, time_col, rate_hz, fmt, "gyro_units", "gyro_columns", "angular_rate")
     if accel_log is None:
         if len(names(accel_columns)) != 3:
             raise InputError("give three names x,y,z of the accelerometer in the gyro's log", "{accel_columns}")
-        acc = fileio.read_sensor_log(log, names(accel_columns), accel_units, time_col, rate_hz, expect="acceleration",
-                                     log_format=fmt, counts=True, field="accel_units")
+        acc = _read(log, names(accel_columns), accel_units, time_col, rate_hz, fmt, "accel_units", "accel_columns",
+                    "acceleration")
     else:
         atime, acols = _split(accel_columns, rate_hz, "accel_columns")
-        acc = fileio.read_sensor_log(accel_log, acols, accel_units, atime, rate_hz, expect="acceleration",
-                                     log_format=fmt, counts=True, field="accel_units")
+        acc = _read(accel_log, acols, accel_units, atime, rate_hz, fmt, "accel_units", "accel_columns", "acceleration")
         step = float(np.median(np.diff(gyr.t)))
         if len(acc.t) != len(gyr.t) or np.abs(acc.t - gyr.t).max() > 0.5 * step:
             bad = min(len(acc.t), len(gyr.t))
@@ -150,13 +173,14 @@ def gyro(
             raise InputError("give rotation numbers, e.g. '1,5'", "{drop_rotations}") from None
     detector = StaticDetector(window, factor, init_static, min_static, gyro_factor)
     session = calibrate_gyro_session(gyr.t, acc.data, gyr.data, acc.shown, gyr.shown, gravity, detector, intervals,
-                                     grange, drop, g_sensitivity, str(log))
+                                     grange, drop, g_sensitivity, str(log),
+                                     None if accel_log is None else str(accel_log))
     acc_cal, gyr_cal = session.accelerometer, session.gyroscope
     if frame is not None or mounting is not None:
-        table = _table_m(frame, str(frame)) if frame is not None else None
+        table, table_sigma = _table_m(frame, str(frame)) if frame is not None else (None, None)
         nominal = np.array(mounting.rows, float) if mounting is not None else None
         acc_cal, gyr_cal, _ = in_system_frame(acc_cal, gyr_cal, table, nominal,
-                                              str(frame) if frame is not None else mounting.text)
+                                              str(frame) if frame is not None else mounting.text, table_sigma)
     inputs = {"log": str(log), "accel_log": None if accel_log is None else str(accel_log), "gyro_columns": gyro_columns,
               "accel_columns": accel_columns, "accel_units": accel_units, "gyro_units": gyro_units,
               "intervals": intervals, "poses": [list(p) for p in session.poses], "dropped_rotations": list(drop),
@@ -168,8 +192,11 @@ def gyro(
         if json_out is not None:
             out.write_json(json_out, result)
         if plot is not None:
-            from align.present.calplots import accel_statics_png
+            from align.present.gyroplot import gyro_session_png
 
-            out.write_bytes(plot, accel_statics_png(acc.t, acc.data, list(session.poses), acc.shown))
+            a_cal, g_cal = session.accelerometer, session.gyroscope
+            force = a_cal.correct(acc.data)
+            out.write_bytes(plot, gyro_session_png(gyr.t, force, g_cal.correct(gyr.data, force), list(session.poses),
+                                                   list(g_cal.rotations), gravity))
     typer.echo(calibration_summary(result.sensors))
-    typer.echo(rotation_table(session, gyr.shown))
+    typer.echo(rotation_table(gyr_cal.rotations))

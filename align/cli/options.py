@@ -116,7 +116,7 @@ COMMAND_FLAGS: dict[str, dict[str, str]] = {
     "simulate": {"units": "--gyro-units"},
     "calibrate ferraris": {"units": "--accel-units", "columns": "--accel-columns or --gyro-columns"},
     "calibrate accel": {"units": "--accel-units"},
-    "calibrate mag": {"units": "--mag-units"},
+    "calibrate mag": {"units": "--mag-units", "columns": "--columns or --accel-columns"},
     "drift": {"manoeuvre": "--manoeuvre"},
 }
 

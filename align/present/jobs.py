@@ -326,7 +326,7 @@ def _count(pool: dict, sensor: str) -> str:
 
 
 def drift_job(rep: Report, path: Path) -> None:
-    """The error growth of a navigation result (issue 16), through :mod:`align.present.navigation`."""
+    """The error growth of a navigation result, through :mod:`align.present.navigation`."""
     from align.navigation.result import DriftResult
     from align.present.navigation import drift_plot_png, navigation_section
     from align.results import load_result

@@ -198,7 +198,7 @@ def make_report(mount: Path | None = None, manoeuvre: Path | None = None, log: P
         jobs.allan_job(rep, allan, allan_columns, allan_rate_hz, allan_units, table_rate, accuracy, noise_ratio, log_format)
     for path in calibrations:
         jobs.calibration_job(rep, path)
-    for path in drift:  # issue 16: the error growth of a navigation result
+    for path in drift:  # the error growth of a navigation result
         jobs.drift_job(rep, path)
     if rep.measured:  # the unit is measured: the budget is a design check and governs nothing
         rep.verdicts = [dataclasses.replace(v, governs=False) if v.design else v for v in rep.verdicts]

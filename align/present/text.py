@@ -307,10 +307,16 @@ def calibration_summary(cals: dict) -> str:
             out.append(matrix_text(np.array(d["g_sensitivity"]), None, 6, "    "))
         out += ["  angles of M's rows (sensor axes) in the calibration frame [deg]:",
                 *angle_lines(angle_rows(c.M, c.sigma_M, unit=matrix_unit(c.units, c.sensor)), "    ")]
-        if d["residuals"]:
+        used = [r for r in getattr(c, "rotations", None) or () if r.get("used", True)]
+        if used:  # calibrate gyro: the angle the rotation table and the note show
+            big = max(used, key=lambda r: r["residual_deg"])
+            out.append(f"  largest residual: rotation {big['rotation']}, {big['residual_deg']:.3g} deg (angle between "
+                       f"the predicted and the measured gravity direction; {len(used)} rotations)")
+        elif d["residuals"]:
             worst = max(d["residuals"].items(), key=lambda kv: float(np.max(np.abs(kv[1]))))
             n = len(d["residuals"])
-            what = f"{n} rotations" if all(k.startswith("rotation ") for k in d["residuals"]) else f"{n} positions"
+            what = (f"{n} rotations" if all(k.startswith("rotation ") for k in d["residuals"]) else
+                    f"{n} poses" if all(k.startswith("attitude ") for k in d["residuals"]) else f"{n} positions")
             if c.sensor == "gyroscope" and "turn" in c.method.lower() and not what.endswith("rotations"):
                 what = f"the {n} static faces, where the bias is fitted; M is fitted from the turns"
             out.append(f"  largest residual: {worst[0]} {np.max(np.abs(worst[1])):.3g} {u} ({what})")
