@@ -18,6 +18,7 @@ ProcessPool, DaskPool, make_pool, BrokenPool
 from __future__ import annotations
 
 import concurrent.futures as cf
+import multiprocessing as mp
 import os
 import signal
 
@@ -41,7 +42,10 @@ class ProcessPool:
         self._ex: cf.ProcessPoolExecutor | None = None
 
     def __enter__(self) -> ProcessPool:
-        self._ex = cf.ProcessPoolExecutor(self.workers, initializer=_ignore_interrupt)
+        # forkserver (spawn where it is missing): a forked worker inherits a parent's OpenMP threads (numba's
+        # parallel kernels once they have run), which GNU OpenMP aborts on
+        method = "forkserver" if "forkserver" in mp.get_all_start_methods() else "spawn"
+        self._ex = cf.ProcessPoolExecutor(self.workers, mp_context=mp.get_context(method), initializer=_ignore_interrupt)
         return self
 
     def __exit__(self, *exc) -> None:
