@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import argparse
 import subprocess
 import sys
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
 
 _LAUNCHER = (
     "import resource, subprocess, sys, time\n"
@@ -38,3 +42,14 @@ def measure(cmd: list[str], repeat: int = 1) -> tuple[float, float]:
     """Best wall time (s) over ``repeat`` runs and the peak RSS (MB) of ``cmd`` alone."""
     best, _, peak = measure_cpu(cmd, repeat)
     return best, peak
+
+
+def in_folder(run: Callable[[argparse.Namespace, Path], None], args: argparse.Namespace, prefix: str) -> None:
+    """``run(args, folder)`` in ``args.keep`` when given (created, kept), else in a temporary folder removed
+    afterwards, also on a failure."""
+    if args.keep:
+        args.keep.mkdir(parents=True, exist_ok=True)
+        run(args, args.keep)
+        return
+    with tempfile.TemporaryDirectory(prefix=prefix) as tmp:
+        run(args, Path(tmp))

@@ -20,7 +20,6 @@ import argparse
 import contextlib
 import io
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -28,7 +27,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _measure import measure  # noqa: E402
+from _measure import in_folder, measure  # noqa: E402
 
 from align.alignment.simulate import SessionSpec  # noqa: E402
 from align.production import simulate_lot  # noqa: E402
@@ -95,13 +94,7 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--dask", action="store_true", help="also a local Dask cluster of 2 workers")
     ap.add_argument("--keep", type=Path, default=None, help="keep the lot and the outputs here")
-    args = ap.parse_args()
-    if args.keep:
-        args.keep.mkdir(parents=True, exist_ok=True)
-        run(args, args.keep)
-        return
-    with tempfile.TemporaryDirectory(prefix="imu_align_bench_batch_") as tmp:  # removed afterwards, also on a failure
-        run(args, Path(tmp))
+    in_folder(run, ap.parse_args(), "imu_align_bench_batch_")
 
 
 def run(args: argparse.Namespace, folder: Path) -> None:

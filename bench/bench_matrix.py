@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -28,7 +27,7 @@ from align.model import SensorModel  # noqa: E402
 from align.units import DEG, to_unit  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _measure import measure  # noqa: E402
+from _measure import in_folder, measure  # noqa: E402
 
 
 def make_session(folder: Path) -> tuple[Path, Path, int]:
@@ -47,13 +46,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--keep", type=Path, default=None, help="keep the generated session here")
-    args = ap.parse_args()
-    if args.keep:
-        args.keep.mkdir(parents=True, exist_ok=True)
-        run(args, args.keep)
-        return
-    with tempfile.TemporaryDirectory(prefix="imu_align_bench_") as tmp:  # removed afterwards, also on a failure
-        run(args, Path(tmp))
+    in_folder(run, ap.parse_args(), "imu_align_bench_")
 
 
 def run(args: argparse.Namespace, folder: Path) -> None:

@@ -88,3 +88,17 @@ def in_chromium(path, tmp_path, shot=None, size="1100,1800") -> str:
         subprocess.run(["chromium", *flags, f"--window-size={size}", f"--screenshot={shot}", path.as_uri()],
                        capture_output=True, timeout=120)
     return re.search(r"<title>(.*?)</title>", res.stdout).group(1)
+
+
+def coning(t: np.ndarray, half: float = 0.05, rate: float = 2 * np.pi * 5) -> tuple[np.ndarray, np.ndarray]:
+    """Classic coning (Savage, Strapdown Analytics 7.1): half-angle ``half`` about x, axis precessing at ``rate``.
+
+    Returns the attitude q(t) = (cos a, 0, sin a cos(W t), sin a sin(W t)) and its body rate
+    omega = 2 vec(q* (x) dq/dt), dq/dt differentiated by hand.
+    """
+    from align.attitude import quat_multiply
+
+    c, s = np.cos(half), np.sin(half)
+    q = np.stack([np.full_like(t, c), 0 * t, s * np.cos(rate * t), s * np.sin(rate * t)], -1)
+    dq = np.stack([0 * t, 0 * t, -s * rate * np.sin(rate * t), s * rate * np.cos(rate * t)], -1)
+    return q, 2 * quat_multiply(q * np.array([1, -1, -1, -1]), dq)[:, 1:]

@@ -32,6 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from align.alignment.kinematics import axis_rotations
 from align.units import DEG, STANDARD_GRAVITY
 
 #: the choices of rotation axes: any (two random axes per rotation), or rotations about the listed body axes only
@@ -94,13 +95,6 @@ class PoseSession:
     b_g: np.ndarray
 
 
-def _exp(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """Rodrigues: ``exp(angle [axis]x)`` for angles (n,) about a unit axis (3,) -> (n, 3, 3)."""
-    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
-    return np.eye(3) + s * k + (1 - c) * (k @ k)
-
-
 def random_sensors(rng: np.random.Generator, misalignment: float = 1.0 * DEG, scale_sd: float = 0.01,
                    gyro_bias_sd: float = 0.5 * DEG, accel_bias_sd: float = 0.05) -> tuple:
     """Random true ``M_a, b_a, M_g, b_g`` (body frame): each row an axis turned by ``misalignment`` (1 sigma
@@ -157,7 +151,7 @@ def simulate_poses(spec: PoseSessionSpec, m_a: np.ndarray, b_a: np.ndarray, m_g:
     ds = (1 - np.cos(2 * np.pi * tau)) / (n_turn * dt)  # ds/dt
     for k in range(spec.poses - 1):
         a, b, fa, fb = _axes(spec, k, rng)
-        ea, eb = _exp(a, fa * s), _exp(b, fb * s)
+        ea, eb = axis_rotations(a, fa * s), axis_rotations(b, fb * s)
         atts.append(c @ ea @ eb)
         rates.append(fb * ds[:, None] * b + np.einsum("kji,j->ki", eb, a) * (fa * ds)[:, None])
         c = atts[-1][-1]

@@ -17,6 +17,7 @@ import math
 
 import numpy as np
 
+from align.present.figures import pyplot
 from align.present.html import Section, esc, html_report, image, table
 
 #: the most panels in one picture
@@ -121,17 +122,8 @@ def _wide(html: str) -> str:
             f'<div class="lotw">{html}</div></div>')
 
 
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 def _grid(n: int):
-    plt = _pyplot()
+    plt = pyplot()
     cols = min(3, n)
     rows = math.ceil(n / cols)
     fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 2.9 * rows), squeeze=False)

@@ -8,7 +8,6 @@ allan_plot_png, allan_ylim, segmentation_plot_png, segmentation_spans, Span
 
 from __future__ import annotations
 
-import io
 import os
 from pathlib import Path
 
@@ -16,21 +15,11 @@ import numpy as np
 
 from align.noise.job import AllanJob
 from align.noise.model import TERM_TABLE
+from align.present.figures import COLOURS, png_bytes, pyplot
 from align.units import to_unit
 
-#: line colours of successive channels
-_COLOURS = ("tab:red", "tab:green", "tab:blue", "tab:purple", "tab:orange", "tab:brown")
 #: line styles of the five single-term asymptotes (Q, N, B, K, R)
 _TERM_STYLES = (":", "-.", ":", "-.", ":")
-
-
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def _term_label_at(y: np.ndarray, lo: float, hi: float, falling: bool, j: int) -> int | None:
@@ -90,7 +79,7 @@ def allan_plot_png(job: AllanJob, target: float | None = None, chosen_tau: float
     bytes
         The PNG file. Rates are shown in deg/h, accelerations in ug.
     """
-    plt = _pyplot()
+    plt = pyplot()
     r = job.result
     shown = "deg/h" if job.sensor == "gyroscope" else "ug"
     fig, ax = plt.subplots(figsize=(7.5, 5))
@@ -100,11 +89,11 @@ def allan_plot_png(job: AllanJob, target: float | None = None, chosen_tau: float
     for k, rr in enumerate(job.run_results):
         style = runs_styles[k % len(runs_styles)]
         for j in range(len(r.names)):
-            ax.loglog(rr.tau, to_unit(rr.adev[j], shown), color=_COLOURS[j % len(_COLOURS)], lw=0.7, alpha=0.7, ls=style)
+            ax.loglog(rr.tau, to_unit(rr.adev[j], shown), color=COLOURS[j % len(COLOURS)], lw=0.7, alpha=0.7, ls=style)
         name = Path(job.inputs[k]).name if k < len(job.inputs) else ""
         ax.plot([], [], color="0.4", lw=0.7, ls=style, label=f"run {k + 1} {name}".rstrip())
     for j, (name, short, f) in enumerate(zip(r.names, _short_names(r.names), job.fits)):
-        c = _COLOURS[j % len(_COLOURS)]
+        c = COLOURS[j % len(COLOURS)]
         ax.loglog(r.tau, to_unit(r.adev[j], shown), color=c, lw=2.2 if job.pooled else 1.5,
                   label=f"{name} (pooled)" if job.pooled else name)
         ax.fill_between(r.tau, to_unit(f.ci_low, shown), to_unit(f.ci_high, shown), color=c, alpha=0.2, lw=0)
@@ -129,10 +118,7 @@ def allan_plot_png(job: AllanJob, target: float | None = None, chosen_tau: float
                  "dotted/dash-dot: identified terms, labelled channel and IEEE letter)", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    return buf.getvalue()
+    return png_bytes(fig)
 
 
 # the segmentation picture lives in its own module; its names are kept here for callers of this one

@@ -18,7 +18,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from align.alignment.result import AlignmentResult
-from align.io.export import matrix_unit
 from align.present.angles import AngleRow, angle_rows, number
 from align.present.presets import preset_lines
 from align.units import DEG, to_unit
@@ -298,15 +297,15 @@ def calibration_summary(cals: dict) -> str:
     out = []
     for name, c in cals.items():
         d = c.to_dict()
-        u = d["units"]["bias"]
+        u, mu = d["units"]["bias"], d["units"]["M"]  # mu: matrix_unit(c.units, c.sensor)
         out += [f"{name} ({d['method']}), convention {d['convention']}",
-                f"  M [{_unit_text(matrix_unit(c.units, c.sensor))}] (1-sigma):", matrix_text(c.M, c.sigma_M, 6, "    "),
+                f"  M [{_unit_text(mu)}] (1-sigma):", matrix_text(c.M, c.sigma_M, 6, "    "),
                 f"  bias [{u}]: " + ", ".join(f"{b:+.6g} ± {s:.2g}" for b, s in zip(d["bias"], d["uncertainty"]["bias"]))]
         if "g_sensitivity" in d:
             out.append(f"  g-sensitivity [{d['units']['g_sensitivity']}]:")
             out.append(matrix_text(np.array(d["g_sensitivity"]), None, 6, "    "))
         out += ["  angles of M's rows (sensor axes) in the calibration frame [deg]:",
-                *angle_lines(angle_rows(c.M, c.sigma_M, unit=matrix_unit(c.units, c.sensor)), "    ")]
+                *angle_lines(angle_rows(c.M, c.sigma_M, unit=mu), "    ")]
         used = [r for r in getattr(c, "rotations", None) or () if r.get("used", True)]
         if used:  # calibrate gyro: the angle the rotation table and the note show
             big = max(used, key=lambda r: r["residual_deg"])

@@ -53,39 +53,30 @@ KIND: dict[str, str] = {
 #: every figure, in the table's column order
 FIGURES: tuple[str, ...] = tuple(KIND)
 
-#: kind -> sensor -> SI unit
-_SI = {
-    "1": {"": "1"},
-    "angle": {"": "rad"},
-    "reading": {"gyroscope": "rad/s", "accelerometer": "m/s^2", "magnetometer": "T"},
-    "white": {"gyroscope": "rad/sqrt(s)", "accelerometer": "m/s/sqrt(s)"},
-    "flicker": {"gyroscope": "rad/s", "accelerometer": "m/s^2"},
-    "walk": {"gyroscope": "rad/s/sqrt(s)", "accelerometer": "m/s^2/sqrt(s)"},
-}
-#: kind -> sensor -> the unit a figure is shown in when no limit states one
-_SHOWN = {
-    "1": {"": "1"},
-    "angle": {"": "deg"},
-    "reading": {"gyroscope": "deg/s", "accelerometer": "m/s^2", "magnetometer": "uT"},
-    "white": {"gyroscope": "deg/sqrt(h)", "accelerometer": "m/s/sqrt(h)"},
-    "flicker": {"gyroscope": "deg/h", "accelerometer": "ug"},
-    "walk": {"gyroscope": "deg/h/sqrt(h)", "accelerometer": "ug/sqrt(h)"},
+#: kind -> sensor -> (SI unit, the unit a figure is shown in when no limit states one)
+_UNITS: dict[str, dict[str, tuple[str, str]]] = {
+    "1": {"": ("1", "1")},
+    "angle": {"": ("rad", "deg")},
+    "reading": {"gyroscope": ("rad/s", "deg/s"), "accelerometer": ("m/s^2", "m/s^2"), "magnetometer": ("T", "uT")},
+    "white": {"gyroscope": ("rad/sqrt(s)", "deg/sqrt(h)"), "accelerometer": ("m/s/sqrt(s)", "m/s/sqrt(h)")},
+    "flicker": {"gyroscope": ("rad/s", "deg/h"), "accelerometer": ("m/s^2", "ug")},
+    "walk": {"gyroscope": ("rad/s/sqrt(s)", "deg/h/sqrt(h)"), "accelerometer": ("m/s^2/sqrt(s)", "ug/sqrt(h)")},
 }
 
 
-def _unit_of(table: dict, figure: str, sensor: str) -> str | None:
-    units = table[KIND[figure]]
-    return units.get("", units.get(sensor))
+def _units_of(figure: str, sensor: str) -> tuple[str, str] | tuple[None, None]:
+    units = _UNITS[KIND[figure]]
+    return units.get("", units.get(sensor)) or (None, None)
 
 
 def si_unit(figure: str, sensor: str) -> str | None:
     """The SI unit of ``figure`` for ``sensor`` (``"rad"``, ``"rad/s"``, ``"1"``); None: the sensor has no such figure."""
-    return _unit_of(_SI, figure, sensor)
+    return _units_of(figure, sensor)[0]
 
 
 def shown_unit(figure: str, sensor: str) -> str:
     """The unit ``figure`` is shown in for ``sensor`` when no limit states one (``"deg"``, ``"deg/sqrt(h)"``)."""
-    return _unit_of(_SHOWN, figure, sensor) or "1"
+    return _units_of(figure, sensor)[1] or "1"
 
 
 def matrix_figures(m: np.ndarray, sigma: np.ndarray | None, mounting: np.ndarray | None = None) -> dict:
@@ -110,7 +101,7 @@ def _vector(name: str, v, sigma=None) -> dict:
 
 def _reading_unit(sensor: str, units: str) -> str:
     """The unit of a row's reading figures: SI for the sensor, or ``count`` for a calibration in counts."""
-    return "count" if units.strip().lower() in ("count", "counts") else _SI["reading"][sensor]
+    return "count" if units.strip().lower() in ("count", "counts") else _UNITS["reading"][sensor][0]
 
 
 def result_rows(result: Result) -> list[dict]:
@@ -159,7 +150,7 @@ def result_rows(result: Result) -> list[dict]:
 
 def _allan_row(job) -> dict:
     """An Allan job's noise terms (N, B, K) and mean per channel (the first three channels as x, y, z)."""
-    row = {"sensor": job.sensor, "verdict": "pass", "bias_unit": _SI["reading"][job.sensor]}
+    row = {"sensor": job.sensor, "verdict": "pass", "bias_unit": _UNITS["reading"][job.sensor][0]}
     hidden = []
     for k, (fit, fig) in enumerate(zip(job.fits[:3], job.figures[:3])):
         a = AXES[k]

@@ -195,14 +195,17 @@ def wilson(k: int, n: int, z: float = 1.959964) -> tuple[float, float]:
 
 def counted(row: dict, figure: str) -> bool:
     """True when ``figure`` of ``row`` is in counts (a calibration in counts: readings, noise terms, ``M``)."""
-    if (row.get("bias_unit") or "") != "count":
-        return False
+    return (row.get("bias_unit") or "") == "count" and _in_counts(figure)
+
+
+def _in_counts(figure: str) -> bool:
+    """True when ``figure`` is in counts for a calibration in counts (readings, noise terms, ``M``)."""
     return KIND[figure] in _COUNTED_KINDS or figure.startswith(("M_", "scale_"))
 
 
 def _group_unit(figure: str, sensor: str, reading_unit: str) -> str:
     """The unit a figure of a (job, sensor, reading unit) group is shown in when no limit states one."""
-    if reading_unit != "count" or not (KIND[figure] in _COUNTED_KINDS or figure.startswith(("M_", "scale_"))):
+    if reading_unit != "count" or not _in_counts(figure):
         return shown_unit(figure, sensor)
     if KIND[figure] in _COUNTED_KINDS:
         return "count"

@@ -34,7 +34,7 @@ import pyarrow.parquet as pq
 
 from align.errors import InputError
 from align.io.files import write_bytes
-from align.production.figures import FIGURES, KIND
+from align.production.figures import FIGURES, KIND, si_unit
 
 #: the non-figure columns, in order, with their Arrow types
 META: tuple[tuple[str, pa.DataType], ...] = (
@@ -44,13 +44,21 @@ META: tuple[tuple[str, pa.DataType], ...] = (
     ("input_hash", pa.string()), ("result", pa.string()), ("seconds", pa.float64()), ("worker", pa.string()),
     ("bias_unit", pa.string()),
 )
-_UNITS = {"1": "1", "angle": "rad", "reading": "SI of the sensor's readings (bias_unit)",
-          "white": "rad/sqrt(s) (gyroscope), m/s/sqrt(s) (accelerometer)",
-          "flicker": "rad/s (gyroscope), m/s^2 (accelerometer)",
-          "walk": "rad/s/sqrt(s) (gyroscope), m/s^2/sqrt(s) (accelerometer)"}
+
+
+def _column_unit(figure: str) -> str:
+    """A figure column's unit, as its field's metadata states it (per sensor where the sensors differ)."""
+    if KIND[figure] == "reading":
+        return "SI of the sensor's readings (bias_unit)"
+    units = {s: si_unit(figure, s) for s in ("gyroscope", "accelerometer")}
+    if len(set(units.values())) == 1:
+        return units["gyroscope"]
+    return ", ".join(f"{u} ({s})" for s, u in units.items())
+
+
 #: the table's schema: :data:`META` then every figure (float64, SI)
 SCHEMA = pa.schema([pa.field(n, t) for n, t in META]
-                   + [pa.field(f, pa.float64(), metadata={"unit": _UNITS[KIND[f]]}) for f in FIGURES],
+                   + [pa.field(f, pa.float64(), metadata={"unit": _column_unit(f)}) for f in FIGURES],
                    metadata={"format": "imu-align.lot-table", "version": "1",
                              "convention": "raw = M true + bias; rows of M are sensor axes; figures SI"})
 
@@ -104,11 +112,11 @@ def read_table(path: str | Path) -> pa.Table:
     return table
 
 
-def append_rows(path: str | Path, rows: Iterable[dict], chunk: int = 256) -> int:
+def append_rows(path: str | Path, rows: Iterable[dict], chunk: int = 256, old: pa.Table | None = None) -> int:
     """Append rows to the table at ``path`` (created when missing): read, concatenate, rewrite atomically.
 
     The rows are turned into Arrow ``chunk`` at a time, so that appending a long run holds few of them as
-    Python objects at once.
+    Python objects at once. ``old``: the table at ``path`` when the caller has read it already.
 
     Returns
     -------
@@ -126,7 +134,7 @@ def append_rows(path: str | Path, rows: Iterable[dict], chunk: int = 256) -> int
     added = sum(p.num_rows for p in parts)
     if not added:
         return 0
-    old = read_table(path)
+    old = read_table(path) if old is None else old
     table = pa.concat_tables(_unified([old, *parts]) if old.num_rows else parts)
     sink = pa.BufferOutputStream()
     pq.write_table(table.replace_schema_metadata({**(table.schema.metadata or {}), **SCHEMA.metadata}), sink,
@@ -194,8 +202,9 @@ class Journal:
             self._fh = None
         if not self.path.exists():
             return 0
+        old = read_table(self.table)
         with open(self.path, encoding="utf-8") as fh:
-            n = append_rows(self.table, _fresh(self.table, _lines(fh)))
+            n = append_rows(self.table, _fresh(old, _lines(fh)), old=old)
         self.path.unlink()
         return n
 
@@ -205,13 +214,10 @@ def _key(row: dict) -> tuple:
     return (row.get("serial"), row.get("job"), row.get("run"), row.get("sensor"))
 
 
-def _fresh(table: Path, rows: Iterable[dict]) -> Iterable[dict]:
+def _fresh(table: pa.Table, rows: Iterable[dict]) -> Iterable[dict]:
     """``rows`` less those the table (and the rows before them) already hold: folding a journal twice (a kill
     between the table's rewrite and the journal's removal) adds nothing the second time."""
-    have = set()
-    if table.exists():
-        old = read_table(table).select(["serial", "job", "run", "sensor"]).to_pylist()
-        have = {_key(r) for r in old}
+    have = {_key(r) for r in table.select(["serial", "job", "run", "sensor"]).to_pylist()}
     for r in rows:
         k = _key(r)
         if k not in have:

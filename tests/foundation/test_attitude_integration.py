@@ -4,32 +4,21 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import coning
 from scipy.spatial.transform import Rotation
 
 from align.attitude import increments, integrate, quat_from_rotvec, quat_multiply, quat_to_matrix, rotation
 
-HALF, CONE, T = 0.05, 2 * np.pi * 5, 2.0  # coning: half-angle 0.05 rad about x, axis precessing at 5 Hz
-
-
-def _cone_q(t):
-    """Classic coning attitude: q(t) = (cos a, 0, sin a cos(W t), sin a sin(W t)) (Savage, Strapdown Analytics 7.1)."""
-    c, s = np.cos(HALF), np.sin(HALF)
-    return np.stack([np.full_like(t, c), 0 * t, s * np.cos(CONE * t), s * np.sin(CONE * t)], -1)
-
-
-def _cone_rate(t):
-    """Body rate of the coning attitude, omega = 2 vec(q* (x) dq/dt), dq/dt differentiated by hand."""
-    s = np.sin(HALF)
-    dq = np.stack([0 * t, 0 * t, -s * CONE * np.sin(CONE * t), s * CONE * np.cos(CONE * t)], -1)
-    return 2 * quat_multiply(_cone_q(t) * np.array([1, -1, -1, -1]), dq)[:, 1:]
+T = 2.0  # coning (conftest.coning): half-angle 0.05 rad about x, axis precessing at 5 Hz
 
 
 def _cone_error(fs, order, jitter=0.0, seed=0):
     t = np.arange(int(T * fs) + 1) / fs
     if jitter:
         t[1:] += np.random.default_rng(seed).uniform(-jitter, jitter, len(t) - 1) / fs
-    q = integrate(_cone_rate(t), np.diff(t) if jitter else 1 / fs, _cone_q(t[:1])[0], order=order)
-    miss = quat_to_matrix(q[-1]).T @ quat_to_matrix(_cone_q(t[-1:])[0])
+    truth, w = coning(t)
+    q = integrate(w, np.diff(t) if jitter else 1 / fs, truth[0], order=order)
+    miss = quat_to_matrix(q[-1]).T @ quat_to_matrix(truth[-1])
     return Rotation.from_matrix(miss).magnitude()
 
 
@@ -56,12 +45,12 @@ def test_uneven_time_steps_keep_the_fourth_order():
 def test_the_coning_term_is_what_cancels_the_drift():
     # without it the trapezoid's rotation vectors drift twice as far on the same coning motion
     t = np.arange(401) / 200
-    w = _cone_rate(t)
+    truth, w = coning(t)
     plain = 0.5 / 200 * (w[:-1] + w[1:])
-    q = _cone_q(t[:1])[0]
+    q = truth[0]
     for p in quat_from_rotvec(plain):
         q = quat_multiply(q, p)
-    drift = Rotation.from_matrix(quat_to_matrix(q).T @ quat_to_matrix(_cone_q(t[-1:])[0])).magnitude()
+    drift = Rotation.from_matrix(quat_to_matrix(q).T @ quat_to_matrix(truth[-1])).magnitude()
     assert drift > 1.8 * _cone_error(200, 2)
 
 

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import coning
 from scipy.spatial.transform import Rotation
 
-from align.attitude import quat_multiply, quat_to_matrix
+from align.attitude import quat_from_rotvec, quat_multiply, quat_to_matrix
 from align.navigation.strapdown import (
     earth_rate_ned,
     euler_from_quat,
@@ -46,19 +47,13 @@ def _turn_errors(fs, duration=20.0, step=1):
 def test_constant_rates_at_rest_keep_the_attitude_exact_and_the_body_still():
     w = np.array([0.3, -0.2, 0.5])
     t = np.arange(1001) / 100
-    q_true = quat_multiply(quat_from_euler(0.1, 0.2, 0.3), _rotvec_quat(np.outer(t, w)))
+    q_true = quat_multiply(quat_from_euler(0.1, 0.2, 0.3), quat_from_rotvec(np.outer(t, w)))
     f = rotate(q_true * np.array([1, -1, -1, -1]), np.array([0, 0, -G]))
     tr = navigate(np.tile(w, (len(t), 1)), f, 0.01, q_true[0], gravity=G)
     miss = Rotation.from_matrix(quat_to_matrix(tr.q[-1]).T @ quat_to_matrix(q_true[-1])).magnitude()
     assert miss < 1e-12
     # the specific force turns with the body: the trapezoid of C f leaves an h^2 velocity error only
     assert np.abs(tr.v).max() < 2e-3 and np.abs(tr.p).max() < 1e-2
-
-
-def _rotvec_quat(phi):
-    a = np.linalg.norm(phi, axis=-1, keepdims=True)
-    s = np.where(a > 0, np.sin(a / 2) / np.where(a > 0, a, 1), 0.5)
-    return np.concatenate([np.cos(a / 2), s * phi], -1)
 
 
 def test_a_coordinated_turn_converges_at_second_order():
@@ -78,25 +73,14 @@ def test_two_speed_steps_keep_the_attitude_and_the_order():
 
 
 # ---- coning at rest (the attitude module's test motion) ----
-HALF, CONE, T = 0.05, 2 * np.pi * 5, 2.0
-
-
-def _cone_q(t):
-    c, s = np.cos(HALF), np.sin(HALF)
-    return np.stack([np.full_like(t, c), 0 * t, s * np.cos(CONE * t), s * np.sin(CONE * t)], -1)
-
-
-def _cone_rate(t):
-    s = np.sin(HALF)
-    dq = np.stack([0 * t, 0 * t, -s * CONE * np.sin(CONE * t), s * CONE * np.cos(CONE * t)], -1)
-    return 2 * quat_multiply(_cone_q(t) * np.array([1, -1, -1, -1]), dq)[:, 1:]
+T = 2.0  # coning (conftest.coning)
 
 
 def _cone_errors(fs, order=4):
     t = np.arange(int(T * fs) + 1) / fs
-    q = _cone_q(t)
+    q, w = coning(t)
     f = rotate(q * np.array([1, -1, -1, -1]), np.array([0, 0, -G]))
-    tr = navigate(_cone_rate(t), f, 1 / fs, q[0], gravity=G, order=order)
+    tr = navigate(w, f, 1 / fs, q[0], gravity=G, order=order)
     att = Rotation.from_matrix(quat_to_matrix(tr.q[-1]).T @ quat_to_matrix(q[-1])).magnitude()
     return att, np.abs(tr.v).max(), np.abs(tr.p).max()
 
