@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import importlib
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar, Protocol, dataclass_transform
 
@@ -35,6 +35,7 @@ from align.errors import InputError
 from align.io.files import read_json, write_json
 from align.io.keys import check_keys
 from align.plausible import check_usable_model
+from align.provenance import Provenance
 from align.units import parse_unit
 from align.values import Value
 
@@ -54,7 +55,7 @@ KNOWN: dict[str, str] = {
 
 _TYPES: dict[str, type[Result]] = {}
 #: the first keys of every result file
-ENVELOPE_KEYS = ("format", "version", "generator", "convention", "units")
+ENVELOPE_KEYS = ("format", "version", "generator", "convention", "units", "provenance")
 
 
 class Correction(Protocol):
@@ -118,15 +119,26 @@ class Result(Value):
     VERSION: ClassVar[int] = 1
     CONVENTION: ClassVar[str]
 
+    #: what the result was computed from (:class:`align.provenance.Provenance`), stamped by the job that made it
+    #: (:meth:`align.job.Job.run`); None for a result made by a library function alone. A keyword-only
+    #: field of every result type, written in the envelope and not compared by ``==``.
+    provenance: Provenance | None
+
     def __init_subclass__(cls, format: str, convention: str, version: int = 1, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
         cls.FORMAT, cls.VERSION, cls.CONVENTION = format, version, convention
+        if "provenance" not in getattr(cls, "__dataclass_fields__", {}):
+            cls.__annotations__ = {**cls.__dict__.get("__annotations__", {}), "provenance": "Provenance | None"}
+            cls.provenance = field(default=None, kw_only=True, compare=False)  # type: ignore[assignment]
         dataclass(frozen=True, eq=False)(cls)
         register(cls)
 
     def envelope(self, units: dict[str, str] | None = None) -> dict[str, Any]:
-        """The envelope of this result (see :func:`envelope`)."""
-        return envelope(self.FORMAT, self.VERSION, self.CONVENTION, units)
+        """The envelope of this result (see :func:`envelope`), with its provenance when it has one."""
+        d = envelope(self.FORMAT, self.VERSION, self.CONVENTION, units)
+        if self.provenance is not None:
+            d["provenance"] = self.provenance.to_dict()
+        return d
 
     @classmethod
     def check_envelope(cls, d: Any, where: str = "result", keys: Iterable[str] | None = None) -> None:
@@ -202,7 +214,10 @@ def result_from_dict(d: Any, where: str = "result") -> Result:
     """The result a dictionary holds, of the type its ``format`` names."""
     if not isinstance(d, dict):
         raise InputError("expected a JSON object", where)
-    return _type_of(d.get("format"), where).from_dict(d, where)
+    result = _type_of(d.get("format"), where).from_dict(d, where)
+    if d.get("provenance") is not None and result.provenance is None:
+        result = result.replace(provenance=Provenance.from_dict(d["provenance"], f"{where}: provenance"))
+    return result
 
 
 def load_result(path: str | Path, expect: tuple[type[Result], ...] | None = None) -> Result:

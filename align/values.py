@@ -58,7 +58,7 @@ def _same(a: Any, b: Any, rtol: float, atol: float) -> bool:
     if dataclasses.is_dataclass(a) and not isinstance(a, type):
         if type(a) is not type(b):
             return False
-        return all(_same(getattr(a, f.name), getattr(b, f.name), rtol, atol) for f in dataclasses.fields(a))
+        return all(_same(getattr(a, f.name), getattr(b, f.name), rtol, atol) for f in dataclasses.fields(a) if f.compare)
     if isinstance(a, dict):
         return isinstance(b, dict) and a.keys() == b.keys() and all(_same(a[k], b[k], rtol, atol) for k in a)
     if isinstance(a, (list, tuple)):

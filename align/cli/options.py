@@ -29,7 +29,7 @@ Domain, ANY, POSITIVE, NONNEGATIVE, NONZERO, ACCURACY, DURATION, PAUSE, TOLERANC
 hertz, quantity, checked_text, number, whole, delimiter, comment, time_units, split_columns, names, value
 (values at the edge);
 JsonOut, Seed, MonteCarlo, RateHz, Quantity, OptQuantity, Text, Number, Whole, Choice, Columns, UnitFlag, GyroUnits,
-Units, Arg, Input, OptInput, Flag, SkipRows, Comment, Delimiter, TimeUnits (typed options: ``name: Type = default``);
+Units, Arg, Input, OptInput, Flag, SkipRows, Comment, Delimiter, TimeColumn, TimeUnits (typed options: ``name: Type = default``);
 log_format (the logger file options as the library's ``LogFormat``)
 """
 
@@ -298,6 +298,9 @@ Comment = Annotated[str | None, typer.Option("--comment", parser=comment, metava
 #: ``--delimiter C``: the field separator of a text log
 Delimiter = Annotated[str | None, typer.Option("--delimiter", parser=delimiter, metavar="C", help=(
     "Field separator of a text log: ',' (default), ';', tab, space (any run of blanks) or another character."))]
+#: ``--time-column NAME``: the time column of a log (default ``time``; the first of four ``--columns`` names, as before)
+TimeColumn = Annotated[str | None, typer.Option("--time-column", metavar="NAME", help=(
+    "Name of the time column (default: time; not read with --rate-hz)."))]
 #: ``--time-units``: the unit of the time column, detected when left out
 TimeUnits = Annotated[str | None, typer.Option("--time-units", parser=time_units, metavar="UNIT", help=(
     "Unit of the time column: s, ms, us or ns (default: detected from the sample interval)."))]
@@ -310,3 +313,15 @@ def log_format(skip_rows: int = 0, comment: str | None = None, delimiter: str | 
     from align.io.formats import LogFormat
 
     return LogFormat(skip_rows, comment, delimiter, time_units)
+
+
+def log_source(path, columns, rate_hz: float | None = None, units: str | None = None, time_column: str | None = None,
+               skip_rows: int = 0, comment: str | None = None, delimiter: str | None = None,
+               time_units: str | None = None):
+    """The log options of a command as the library's ``align.io.source.LogSource`` (``columns`` as typed: a comma
+    list, or None for the sensor's defaults)."""
+    from align.io.source import LogSource
+
+    return LogSource(path=Path(path), columns=None if columns is None else tuple(names(columns)),
+                     time_column=time_column, rate_hz=rate_hz, units=units,
+                     format=log_format(skip_rows, comment, delimiter, time_units))

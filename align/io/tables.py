@@ -21,12 +21,10 @@ from align.errors import InputError
 from align.io.files import existing_file
 from align.io.formats import LogFormat, content_lines, csv_source, preamble_hint
 
-_BINARY = (".npy", ".parquet")
-
 
 def read_columns(path: str | Path, names: list[str] | None = None, time_column: str | None = None,
                  log_format: LogFormat | None = None) -> tuple[list[str], np.ndarray]:
-    """Read named numeric columns of a CSV (.csv, .csv.gz, .txt), blank-separated text, .parquet or .npy file.
+    """Read named numeric columns of a log, by the reader its format registers (:mod:`align.io.readers`).
 
     Parameters
     ----------
@@ -45,33 +43,51 @@ def read_columns(path: str | Path, names: list[str] | None = None, time_column: 
     names : list of str
     data : ndarray, shape (n, k), float64
     """
+    from align.io.readers import reader_for
+
     p = existing_file(path)
     fmt = log_format or LogFormat()
-    suffixes = "".join(p.suffixes[-2:]).lower()
-    if p.suffix.lower() in _BINARY and fmt.given():
+    reader = reader_for(p, fmt)
+    if not reader.text and fmt.given():
         given = ", ".join("{" + k + "}" for k in fmt.given())
         raise InputError(f"{given} apply to text logs, not to a {p.suffix} file; leave them out", str(path))
-    if p.suffix.lower() == ".npy":
-        return _npy_columns(p, names)
-    if p.suffix.lower() == ".parquet":
-        import pyarrow.parquet as pq
+    return reader.read(p, names, time_column, fmt)
 
-        try:
-            _require(names, pq.read_schema(p).names, path, time_column)
-            table = _as_float(pq.read_table(p, columns=names), path)
-        except InputError:
-            raise
-        except Exception as exc:  # pyarrow raises several types for a bad or damaged file
-            raise InputError(f"cannot read parquet ({_first_line(exc)})", str(path)) from None
-    elif _is_whitespace_table(p, fmt):
-        return _whitespace_columns(p, names, fmt)
-    elif suffixes.endswith((".csv", ".csv.gz", ".txt", ".txt.gz")) or p.suffix.lower() in (".csv", ".gz"):
-        table = _csv_table(p, names, time_column, fmt)
-    else:
-        raise InputError("unknown file type; use .csv, .csv.gz, .npy or .parquet", str(path))
+
+def parquet_columns(p: Path, names: list[str] | None, time_column: str | None, fmt: LogFormat
+                    ) -> tuple[list[str], np.ndarray]:
+    """Named columns of a Parquet file (pyarrow)."""
+    import pyarrow.parquet as pq
+
+    try:
+        _require(names, pq.read_schema(p).names, p, time_column)
+        table = _as_float(pq.read_table(p, columns=names), p)
+    except InputError:
+        raise
+    except Exception as exc:  # pyarrow raises several types for a bad or damaged file
+        raise InputError(f"cannot read parquet ({_first_line(exc)})", str(p)) from None
+    return _arrow_columns(table, names, p)
+
+
+def csv_columns(p: Path, names: list[str] | None, time_column: str | None, fmt: LogFormat
+                ) -> tuple[list[str], np.ndarray]:
+    """Named columns of a delimited text file with a header (pyarrow's CSV reader); a header-less
+    blank-separated table of numbers as ``col0, col1, ...``."""
+    if is_whitespace_table(p, fmt):
+        return whitespace_columns(p, names, fmt)
+    return _arrow_columns(_csv_table(p, names, time_column, fmt), names, p)
+
+
+def npy_columns(p: Path, names: list[str] | None, time_column: str | None, fmt: LogFormat
+                ) -> tuple[list[str], np.ndarray]:
+    """The columns of a 2-D .npy array, in order (``col0, col1, ...`` unless ``names`` matches its width)."""
+    return _npy_columns(p, names)
+
+
+def _arrow_columns(table, names: list[str] | None, p: Path) -> tuple[list[str], np.ndarray]:
     cols = names or table.column_names
     if table.num_rows == 0:
-        raise InputError("has no data rows (a header alone); record data into it", str(path))
+        raise InputError("has no data rows (a header alone); record data into it", str(p))
     data = np.empty((len(cols), table.num_rows))  # filled row by row, returned transposed
     for j, name in enumerate(cols):
         pos = 0
@@ -141,7 +157,7 @@ def _float_chunk(chunk) -> np.ndarray:
     return arr
 
 
-def _is_whitespace_table(p: Path, fmt: LogFormat) -> bool:
+def is_whitespace_table(p: Path, fmt: LogFormat) -> bool:
     """A header-less text table of numbers separated by blanks (imu_tk's .mat text, ``x y z`` files)."""
     if p.suffix.lower() in (".npy", ".parquet", ".gz") or fmt.delimiter not in (None, " ", "\t"):
         return False
@@ -160,7 +176,7 @@ def _is_whitespace_table(p: Path, fmt: LogFormat) -> bool:
     return True
 
 
-def _whitespace_columns(p: Path, names: list[str] | None, fmt: LogFormat) -> tuple[list[str], np.ndarray]:
+def whitespace_columns(p: Path, names: list[str] | None, fmt: LogFormat) -> tuple[list[str], np.ndarray]:
     """Columns ``col0, col1, ...`` of a blank-separated numeric table (parsed in C by numpy)."""
     raw = p.read_bytes()
     try:

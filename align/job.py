@@ -1,0 +1,102 @@
+"""A job: one command's unit of work, as a library call.
+
+Every command of ``imu-align`` is one :class:`Job`: a frozen options value (every field typed,
+in SI, with its default: the one place defaults live) and ``run(options) -> Result``, which reads
+its inputs through the one log reader (:mod:`align.io.source`), checks them, computes, and stamps
+the result with its :class:`~align.provenance.Provenance` (input files with size and hash, the
+options, the tool version). The command line parses words into the options, calls ``run`` and
+renders the result; the report and the batch call the same ``run``; so does a notebook::
+
+    from align.api import jobs, MatrixOptions
+    result = jobs["matrix"].run(MatrixOptions(log=..., plan=...))
+
+A job is two steps, so that a caller that also draws the readings (``--plot``) reads them once:
+``read(options) -> inputs`` (files -> checked inputs, a job's own frozen type) and
+``compute(inputs, options, progress) -> result``. ``run`` is the two in turn.
+
+Public names
+------------
+Job, Progress
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Generic, TypeVar
+
+from align.provenance import Provenance
+from align.results import Result
+
+__all__ = ["Job", "Progress"]
+
+#: ``progress(n)``: n more units of work done (samples read, runs made); the library never draws it
+Progress = Callable[[int], None]
+
+O = TypeVar("O")  # noqa: E741  (the options type)
+I = TypeVar("I")  # noqa: E741  (the checked inputs)
+R = TypeVar("R", bound=Result)
+
+
+@dataclass(frozen=True)
+class Job(Generic[O, I, R]):
+    """One command's unit of work.
+
+    Attributes
+    ----------
+    name : str
+        The command that runs it (``"matrix"``, ``"calibrate accel"``).
+    options : type
+        Its frozen, keyword-only options type.
+    read : callable
+        ``read(options) -> inputs``: the input files read through the one log reader and checked;
+        raises :class:`~align.errors.InputError` naming the file, field or option.
+    compute : callable
+        ``compute(inputs, options, progress) -> Result``; ``progress`` may be None.
+    files : callable
+        ``files(options) -> {role: path or None}``: the input files the result depends on (its
+        provenance, and the batch's content hash).
+    summary : str
+        One line: what the job does.
+    """
+
+    name: str
+    options: type[O]
+    read: Callable[[O], I]
+    compute: Callable[[I, O, Progress | None], R]
+    files: Callable[[O], Mapping[str, Path | str | None]]
+    summary: str = ""
+
+    def stamp(self, result: R, options: O) -> R:
+        """``result`` with the provenance of this job run with ``options``."""
+        return result.replace(provenance=Provenance.of(self.name, self.files(options), options))
+
+    def run(self, options: O, *, progress: Progress | None = None) -> R:
+        """Read, check and compute: the job's result with its provenance.
+
+        Parameters
+        ----------
+        options : the job's options type
+        progress : callable, optional
+            Called with the units of work done as they are done.
+
+        Returns
+        -------
+        Result
+            The job's result type, its ``provenance`` set.
+        """
+        if not isinstance(options, self.options):
+            raise TypeError(f"{self.name} takes {self.options.__name__}, not {type(options).__name__}")
+        inputs = self.read(options)
+        return self.stamp(self.compute(inputs, options, progress), options)
+
+    def run_with_inputs(self, options: O, *, progress: Progress | None = None) -> tuple[R, I]:
+        """As :meth:`run`, and the checked inputs too (for a caller that also draws them)."""
+        inputs = self.read(options)
+        return self.stamp(self.compute(inputs, options, progress), options), inputs
+
+
+def describe(job: Job[Any, Any, Any]) -> str:
+    """``name: summary`` of a job, for listings."""
+    return f"{job.name}: {job.summary}" if job.summary else job.name
