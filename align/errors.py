@@ -70,12 +70,13 @@ class AlignError(Exception):
         super().__init__(self.render())
 
     def _where_is_field(self) -> bool:
-        return bool(self.where) and _PLACEHOLDER.fullmatch(self.where) is not None
+        return self.where is not None and _PLACEHOLDER.fullmatch(self.where) is not None
 
     @property
     def fields(self) -> list[str]:
         """Inputs named by the error (a placeholder ``where`` and the message's placeholders)."""
-        return (field_names(self.where) if self._where_is_field() else []) + field_names(self.message)
+        named = field_names(self.where) if self.where is not None and self._where_is_field() else []
+        return named + field_names(self.message)
 
     def render(self, spell: Callable[[str, str | None], str] = _python_spelling) -> str:
         """The error as one line, inputs spelled by ``spell(name, value_or_None)``."""

@@ -22,6 +22,7 @@ import difflib
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
+from typing import Any
 
 from align.errors import InputError, literal
 from align.units import parse_quantity
@@ -328,6 +329,6 @@ def merge_parts(user: Mapping[str, Part], base: Mapping[str, Part] | None = None
         if old is None:
             table[name] = part
             continue
-        figs = {k: f for k, f in part.figures()}
+        figs: dict[str, Any] = dict(part.figures())  # figure fields by name: replace() checks the names
         table[old.name] = replace(old, kind=part.kind or old.kind, **figs)
     return table

@@ -26,7 +26,7 @@ import importlib
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, ClassVar, Protocol, dataclass_transform
+from typing import Any, ClassVar, Protocol, Self, TypeVar, dataclass_transform, overload
 
 import numpy as np
 
@@ -43,9 +43,10 @@ from align.values import Value
 KNOWN: dict[str, str] = {
     "imu-align.alignment": "align.alignment.result",
     "imu-align.truth": "align.alignment.simulate",
+    "imu-align.corrected": "align.alignment.corrected",
     "imu-align.calibration": "align.calibration.results",
     "imu-align.magnetometer": "align.calibration.magnetometer",
-    "imu-align.allan": "align.noise.job",
+    "imu-align.allan": "align.noise.analysis",
     "imu-align.plan": "align.noise.planner",
     "imu-align.allowable": "align.sensitivity.allowable",
     "imu-align.check": "align.sensitivity.margins",
@@ -69,8 +70,12 @@ class Correction(Protocol):
         Unit of the readings in the result's file (the default unit of the log).
     """
 
-    sensor: str
-    units: str
+    # read-only: a result states them as a property or a (frozen) field
+    @property
+    def sensor(self) -> str: ...
+
+    @property
+    def units(self) -> str: ...
 
     def correct(self, raw: np.ndarray) -> np.ndarray:
         """Corrected readings (n, 3), SI, from raw readings (n, 3), SI."""
@@ -93,7 +98,7 @@ def file_unit(d: dict[str, Any], key: str, expect: str | None, where: str) -> tu
     return unit, parse_unit(unit, expect, f"{where}: units.{key}").factor
 
 
-def envelope(format: str, version: int, convention: str, units: dict[str, str] | None = None) -> dict[str, Any]:
+def envelope(format: str, version: int, convention: str, units: dict[str, Any] | None = None) -> dict[str, Any]:
     """The first keys of every result file: format, version, generator, convention, units."""
     return {"format": format, "version": version, "generator": f"imu-align {__version__}",
             "convention": convention, "units": dict(units or {})}
@@ -133,7 +138,7 @@ class Result(Value):
         dataclass(frozen=True, eq=False)(cls)
         register(cls)
 
-    def envelope(self, units: dict[str, str] | None = None) -> dict[str, Any]:
+    def envelope(self, units: dict[str, Any] | None = None) -> dict[str, Any]:
         """The envelope of this result (see :func:`envelope`), with its provenance when it has one."""
         d = envelope(self.FORMAT, self.VERSION, self.CONVENTION, units)
         if self.provenance is not None:
@@ -165,7 +170,7 @@ class Result(Value):
         """
         raise InputError(f"holds an {self.FORMAT} result, which corrects no log; give an alignment or a calibration", where)
 
-    def _only_sensor(self, held: str, sensor: str | None, where: str, matrix: str = "M") -> Correction:
+    def _only_sensor(self, held: str, sensor: str | None, where: str, matrix: str = "M") -> Self:
         """``self`` when ``sensor`` is None or ``held`` (for results of one sensor), its ``matrix`` checked usable.
 
         Raises
@@ -177,7 +182,7 @@ class Result(Value):
         if sensor is not None and sensor != held:
             raise InputError(f"holds a {held} result, no {sensor} calibration; choose another {{sensor}}", where)
         check_usable_model(getattr(self, matrix), where, matrix)
-        return self  # type: ignore[return-value]
+        return self
 
     def to_dict(self) -> dict[str, Any]:  # pragma: no cover - every subclass implements it
         raise NotImplementedError
@@ -218,6 +223,20 @@ def result_from_dict(d: Any, where: str = "result") -> Result:
     if d.get("provenance") is not None and result.provenance is None:
         result = result.replace(provenance=Provenance.from_dict(d["provenance"], f"{where}: provenance"))
     return result
+
+
+_R = TypeVar("_R", bound="Result")
+_R2 = TypeVar("_R2", bound="Result")
+
+
+@overload
+def load_result(path: str | Path, expect: None = None) -> Result: ...
+@overload
+def load_result(path: str | Path, expect: tuple[type[_R]]) -> _R: ...
+@overload
+def load_result(path: str | Path, expect: tuple[type[_R], type[_R2]]) -> _R | _R2: ...
+@overload
+def load_result(path: str | Path, expect: tuple[type[Result], ...]) -> Result: ...
 
 
 def load_result(path: str | Path, expect: tuple[type[Result], ...] | None = None) -> Result:

@@ -18,7 +18,7 @@ import re
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import lru_cache
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, overload
 
 from align.errors import UnitError, literal
 
@@ -72,7 +72,7 @@ class Unit:
         return Unit(self.factor ** float(p), tuple(a * p for a in self.dim))
 
 
-def _u(factor: float, **exps: int) -> Unit:
+def _u(factor: float, **exps: int | Fraction) -> Unit:
     return Unit(factor, tuple(Fraction(exps.get(b, 0)) for b in _BASES))
 
 
@@ -305,6 +305,12 @@ def parse_scale(text: str, expect: str, where: str | None = None) -> tuple[float
     return size, SHOWN_IN[expect]
 
 
+@overload
+def to_unit(value_si: float, unit: str) -> float: ...
+@overload
+def to_unit(value_si: np.ndarray, unit: str) -> np.ndarray: ...
+@overload
+def to_unit(value_si: float | np.ndarray, unit: str) -> float | np.ndarray: ...
 def to_unit(value_si: float | np.ndarray, unit: str) -> float | np.ndarray:
     """Convert an SI value to ``unit`` (the inverse of :func:`parse_quantity`).
 

@@ -108,7 +108,7 @@ class Value:
     """
 
     def __post_init__(self) -> None:
-        for f in dataclasses.fields(self):
+        for f in dataclasses.fields(self):  # type: ignore[arg-type]  # a mixin: every subclass is a dataclass
             v = getattr(self, f.name)
             if isinstance(v, np.ndarray):
                 object.__setattr__(self, f.name, frozen_array(v, dtype=v.dtype))
@@ -116,7 +116,7 @@ class Value:
     def __eq__(self, other: object) -> bool:
         return type(self) is type(other) and _same(self, other, 0.0, 0.0)
 
-    __hash__ = None  # values holding arrays are not hashable
+    __hash__ = None  # type: ignore[assignment]  # values holding arrays are not hashable
 
     def replace(self, **changes: Any) -> Self:
         """A copy with some fields changed (``dataclasses.replace``).
@@ -132,4 +132,4 @@ class Value:
             A new value of the same type (``__post_init__`` runs again: new
             arrays are copied read-only); the original is unchanged.
         """
-        return dataclasses.replace(self, **changes)
+        return dataclasses.replace(self, **changes)  # type: ignore[type-var]  # a mixin: every subclass is a dataclass

@@ -1,17 +1,19 @@
 """Benchmark: `imu-align batch` on a simulated lot of 200 units (6-dwell sessions at 200 Hz, 10 s dwells, 3 s gaps).
 
 Measures, on the same lot:
-  1. the in-process cost of one unit's alignment: the library alone (read the log and the plan, align) and the
-     single command in-process (`align.cli.run([...])`: parsing, the same alignment, the JSON, the summary);
+  1. the in-process cost of one unit's alignment: the library job alone (`align.api.job("matrix").run(options)`:
+     read the log and the plan, check, align, provenance) and the single command in-process (`align.cli.run([...])`:
+     parsing, the same job, the JSON, the summary), in wall time and CPU time;
   2. the whole `imu-align batch MANIFEST --workers N` process (start-up included) with 1 and 2 workers:
-     throughput (units/s), per-unit wall time and its overhead over the library's alignment, and the scaling
+     throughput (units/s), per-unit wall time and its overhead over the library job (target < 10 %), the same in
+     CPU time (the whole process tree's: what other users of a shared machine cannot inflate), and the scaling
      efficiency from 1 to 2 workers, T1 / (2 T2) (target >= 80 %);
   3. peak RSS (the largest process: the batch or one of its workers) with 200 and 1,000 units (the 1,000-unit
      manifest lists the 200 sessions five times under other serials: the batch keeps nothing per unit, so
      memory stays flat as the lot grows).
 Every file is made in a temporary folder, removed at the end (also on a failure), unless --keep.
 
-    python bench/bench_batch.py [--units 200] [--big 1000] [--repeat 1] [--dask] [--keep DIR]
+    python bench/bench_batch.py [--units 200] [--big 1000] [--repeat 1] [--dask] [--keep DIR] [--no-bytecode]
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import io
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -27,7 +30,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _measure import in_folder, measure  # noqa: E402
+from _measure import in_folder, measure_cpu  # noqa: E402
 
 from align.alignment.simulate import SessionSpec  # noqa: E402
 from align.production import simulate_lot  # noqa: E402
@@ -35,31 +38,48 @@ from align.production import simulate_lot  # noqa: E402
 FULL = SessionSpec(fs=200.0, dwell_s=10.0, static_s=3.0)
 
 
-def in_process(lot, k: int = 20) -> tuple[float, float]:
-    """Mean seconds per unit of the library's alignment alone and of the single command in-process (warm)."""
-    import align.io as fileio
-    from align.alignment.job import AlignOptions, align
-    from align.alignment.plan import Plan
+def worker_seconds(table: Path) -> float:
+    """Mean seconds per unit inside the workers (the table's ``seconds``), the first unit of the run left out."""
+    import pyarrow.parquet as pq
+
+    seconds = sorted(pq.read_table(table).to_pydict()["seconds"])
+    return sum(seconds[:-1]) / max(1, len(seconds) - 1)
+
+
+def in_process(lot, k: int = 20, command: bool = True) -> tuple[tuple[float, float], tuple[float, float]]:
+    """Mean (wall, CPU) seconds per unit of the library job alone and of the single command in-process (warm;
+    without ``command``, the library job's only)."""
     from align.cli import run
 
     serials = lot.serials("good")[:k]
     logs = [lot.folder / "sessions" / f"{s}.csv" for s in serials]
+    try:
+        import align.api as ia
 
-    def library(log):
-        got = fileio.read_sensor_log(log, ["gyro_x", "gyro_y", "gyro_z"], "deg/s", "time", None)
-        align(got.t, got.data, Plan.from_dict(fileio.read_toml(lot.plan), str(lot.plan)), AlignOptions())
+        job = ia.job("matrix")
 
-    def command(log):
+        def library(log):
+            job.run(ia.MatrixOptions(log=ia.LogSource(path=log), plan=lot.plan))
+    except (ImportError, AttributeError):  # before the matrix job: the alignment functions themselves
+        import align.io as fileio
+        from align.alignment.job import AlignOptions, align
+        from align.alignment.plan import Plan
+
+        def library(log):
+            got = fileio.read_sensor_log(log, ["gyro_x", "gyro_y", "gyro_z"], "deg/s", "time", None)
+            align(got.t, got.data, Plan.from_dict(fileio.read_toml(lot.plan), str(lot.plan)), AlignOptions())
+
+    def single(log):
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
             assert run(["matrix", str(log), "--plan", str(lot.plan), "--json", str(lot.folder / "one.json")]) == 0
 
-    out = []
-    for fn in (library, command):
+    out = [(float("nan"), float("nan"))] * 2
+    for i, fn in enumerate((library, single) if command else (library,)):
         fn(logs[0])  # warm: imports, numba
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         for log in logs:
             fn(log)
-        out.append((time.perf_counter() - t0) / len(logs))
+        out[i] = ((time.perf_counter() - t0) / len(logs), (time.process_time() - c0) / len(logs))
     return out[0], out[1]
 
 
@@ -74,17 +94,58 @@ def big_manifest(lot, n: int) -> Path:
     return path
 
 
-def batch(manifest: Path, out: Path, workers: int, repeat: int, scheduler: str | None = None) -> tuple[float, float]:
-    """Best wall time and peak RSS of the whole batch process, each repeat into a fresh output folder."""
-    best, peak = float("inf"), 0.0
-    for r in range(repeat):
-        cmd = [sys.executable, "-m", "align.cli", "batch", str(manifest), "--workers", str(workers),
-               "--out", str(out / f"w{workers}{scheduler or ''}-{r}")]
-        if scheduler:
-            cmd += ["--scheduler", scheduler]
-        wall, rss = measure(cmd)
-        best, peak = min(best, wall), max(peak, rss)
-    return best, peak
+def run_tree(cmd: list[str]) -> tuple[float, float, float]:
+    """Wall time (s), CPU time (user + system, s) and peak RSS (MB, the largest process) of ``cmd`` and every
+    process under it: its workers are counted (a fork server's are not its children, so its own rusage misses
+    them), sampled every 20 ms with psutil; without psutil, CPU is NaN and RSS the largest child's."""
+    try:
+        import psutil
+    except ImportError:
+        wall, _, rss = measure_cpu(cmd)
+        return wall, float("nan"), rss
+    seen: dict[int, float] = {}
+    peak = 0
+    t0 = time.perf_counter()
+    proc = psutil.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    while proc.poll() is None:
+        with contextlib.suppress(psutil.Error):
+            for p in [proc, *proc.children(recursive=True)]:
+                with contextlib.suppress(psutil.Error):
+                    with p.oneshot():
+                        t = p.cpu_times()
+                        seen[p.pid] = t.user + t.system
+                        peak = max(peak, p.memory_info().rss)
+        time.sleep(0.02)
+    wall = time.perf_counter() - t0
+    if proc.returncode != 0:
+        raise SystemExit(f"failed: {' '.join(cmd)}\n{proc.stderr.read().decode()}")
+    return wall, sum(seen.values()), peak / 2**20
+
+
+_PLAIN = (
+    "import sys\n"
+    "from pathlib import Path\n"
+    "import align.api as ia\n"
+    "folder = Path(sys.argv[1])\n"
+    "job = ia.job('matrix')\n"
+    "for log in sorted((folder / 'sessions').glob('*.csv')):\n"
+    "    job.run(ia.MatrixOptions(log=ia.LogSource(path=log), plan=folder / 'plan.toml'))\n"
+)
+
+
+def plain_process(lot) -> tuple[float, float]:
+    """Wall and CPU time of the library job over every unit of the lot in one plain Python process (its start
+    and imports included; no JSON, no table): what any process of the jobs costs."""
+    wall, cpu, _ = run_tree([sys.executable, "-c", _PLAIN, str(lot.folder)])
+    return wall, cpu
+
+
+def batch(manifest: Path, out: Path, workers: int, scheduler: str | None = None, tag: str = "0"
+          ) -> tuple[float, float, float]:
+    """Wall time, CPU time (every process) and peak RSS of one whole batch process into a fresh output folder."""
+    cmd = [sys.executable, "-m", "align.cli", "batch", str(manifest), "--workers", str(workers)]
+    cmd += ["--scheduler", scheduler] if scheduler else []
+    return run_tree([*cmd, "--out", str(out / f"w{workers}{scheduler or ''}-{tag}")])
 
 
 def main() -> None:
@@ -94,31 +155,78 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--dask", action="store_true", help="also a local Dask cluster of 2 workers")
     ap.add_argument("--keep", type=Path, default=None, help="keep the lot and the outputs here")
+    ap.add_argument("--no-bytecode", action="store_true", help=(
+        "run the batches as this environment says (PYTHONDONTWRITEBYTECODE: every process compiles imu-align's "
+        "modules again); default: their bytecode cached in the bench's folder, as an installed package has it"))
     in_folder(run, ap.parse_args(), "imu_align_bench_batch_")
 
 
 def run(args: argparse.Namespace, folder: Path) -> None:
+    import os
+
     t0 = time.perf_counter()
     lot = simulate_lot(folder / "lot", args.units, session=FULL, bad=0, seed=1)
+    if not args.no_bytecode:  # the batches' processes (started below) write and read their bytecode here
+        os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
+        os.environ["PYTHONPYCACHEPREFIX"] = str(folder / "pycache")
+        batch(big_manifest(lot, 2), folder / "warm", 1)
     size = sum(p.stat().st_size for p in (lot.folder / "sessions").iterdir()) / 1e6
     rows = sum(1 for _ in open(lot.folder / "sessions" / "SN0001.csv")) - 1
     print(f"lot: {args.units} units, {rows} rows each (6 dwells of 10 s at 200 Hz), {size:.0f} MB of CSV, "
           f"simulated in {time.perf_counter() - t0:.1f} s")
-    lib, cmd = in_process(lot)
-    print(f"in-process, one unit: library alignment (read + align) {1e3 * lib:6.1f} ms; "
-          f"single command via align.cli.run {1e3 * cmd:6.1f} ms")
-    t1, m1 = batch(lot.manifest, folder / "out", 1, args.repeat)
-    t2, m2 = batch(lot.manifest, folder / "out", 2, args.repeat)
+    (lib0, cpu0), (cmd, cmd_cpu) = in_process(lot)
+    print(f"in-process, one unit: library job (read + check + align + provenance) {1e3 * lib0:6.1f} ms "
+          f"(CPU {1e3 * cpu0:6.1f} ms); single command via align.cli.run {1e3 * cmd:6.1f} ms (CPU {1e3 * cmd_cpu:6.1f} ms)")
+    # side by side, the best of --repeat rounds of: the library job, a batch of 1 worker, the library job, a batch
+    # of 2 workers (a shared machine's load drifts: each ratio is of figures taken minutes apart at most)
+    lib, t1, t2 = [lib0], [], []
+    cpu, c1, c2, m1, m2 = [cpu0], [], [], 0.0, 0.0
+    for r in range(args.repeat):
+        if r:
+            (w, c), _ = in_process(lot, command=False)
+            lib.append(w)
+            cpu.append(c)
+        t, c, m = batch(lot.manifest, folder / "out", 1, tag=str(r))
+        t1.append(t), c1.append(c)
+        m1 = max(m1, m)
+        (w, c), _ = in_process(lot, command=False)
+        lib.append(w)
+        cpu.append(c)
+        t, c, m = batch(lot.manifest, folder / "out", 2, tag=str(r))
+        t2.append(t), c2.append(c)
+        m2 = max(m2, m)
     n = args.units
-    for w, t, m in ((1, t1, m1), (2, t2, m2)):
-        print(f"batch --workers {w}: {t:6.2f} s  {n / t:6.2f} units/s  {1e3 * t / n * w:6.1f} ms per unit per worker "
-              f"(overhead over the library's alignment {1e3 * (t / n * w - lib):6.1f} ms)  peak RSS {m:6.1f} MB")
-    print(f"scaling 1 -> 2 workers: {t1 / t2:.2f}x, efficiency {100 * t1 / (2 * t2):.0f} % (target >= 80 %)")
+    lib_best, cpu_best = min(lib), min(cpu)
+    for w, t, c, m in ((1, min(t1), min(c1), m1), (2, min(t2), min(c2), m2)):
+        per, per_cpu = t / n * w, c / n
+        print(f"batch --workers {w}: {t:6.2f} s  {n / t:6.2f} units/s  {1e3 * per:6.1f} ms per unit per worker, "
+              f"library job {1e3 * lib_best:6.1f} ms: overhead {1e3 * (per - lib_best):+6.1f} ms, "
+              f"{100 * (per / lib_best - 1):+5.1f} %; CPU (every process) {1e3 * per_cpu:6.1f} ms per unit vs "
+              f"{1e3 * cpu_best:6.1f} ms: {100 * (per_cpu / cpu_best - 1):+5.1f} %; peak RSS {m:6.1f} MB")
+    inside = worker_seconds(folder / "out" / "w1-0" / "results.parquet")
+    print(f"in a worker (--workers 1, the table's seconds, first unit left out): {1e3 * inside:6.1f} ms per unit "
+          f"(job + JSON + rows)")
+    pw, pc = plain_process(lot)
+    print(f"the library job over the lot in one plain process (start-up included, no JSON, no table): {pw:6.2f} s, "
+          f"{1e3 * pw / n:6.1f} ms per unit ({100 * (pw / n / lib_best - 1):+5.1f} % over the library job in-process); "
+          f"batch --workers 1 over it: {100 * (min(t1) / pw - 1):+5.1f} %")
+    print(f"scaling 1 -> 2 workers: {min(t1) / min(t2):.2f}x, efficiency {100 * min(t1) / (2 * min(t2)):.0f} % "
+          "(target >= 80 %)")
+    print("rounds (wall s, w1 / w2; library ms): " + "; ".join(
+        f"{a:.2f} / {b:.2f}" for a, b in zip(t1, t2)) + "; " + ", ".join(f"{1e3 * x:.1f}" for x in lib))
     if args.dask:
-        td, md = batch(lot.manifest, folder / "out", 2, args.repeat, "local")
+        td, _, md = batch(lot.manifest, folder / "out", 2, "local")
         print(f"batch --scheduler local --workers 2: {td:6.2f} s  {n / td:6.2f} units/s  peak RSS {md:6.1f} MB")
     if args.big:
-        tb, mb = batch(big_manifest(lot, args.big), folder / "out", 2, 1)
+        # the per-unit cost with the fixed start-up (interpreter, imports, pool, the table's first write) taken
+        # out: the slope of the batch's wall time over the lot's size, one worker, against the library job
+        big = big_manifest(lot, args.big)
+        tb1, _, _ = batch(big, folder / "out", 1, tag="big1")
+        slope = (tb1 - min(t1)) / (args.big - n)
+        print(f"batch --workers 1, {n} and {args.big} units: {min(t1):.2f} s and {tb1:.2f} s; per unit beyond the "
+              f"start-up (the slope) {1e3 * slope:6.1f} ms vs the library job {1e3 * lib_best:6.1f} ms: overhead "
+              f"{100 * (slope / lib_best - 1):+5.1f} % (target < 10 %); fixed start-up {min(t1) - n * slope:.2f} s")
+        tb, _, mb = batch(big, folder / "out", 2, tag="big")
         print(f"batch of {args.big} units, --workers 2: {tb:6.2f} s  {args.big / tb:6.2f} units/s  peak RSS {mb:6.1f} MB "
               f"(vs {m2:.1f} MB for {n}: {'flat' if mb < 1.15 * m2 else 'GROWS'})")
 

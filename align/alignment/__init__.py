@@ -14,14 +14,15 @@ twoaxis   the two-axis shortcut (Eq 35-36): the third column inferred, with its 
 checks    checks that turn a bad test into a clear error
 kinematics, timeline, simulate
           rate-table session simulator of known truth (orientation, moves, Earth rate)
-job       the alignment job (:func:`align`)
+pipeline  the alignment pipeline (:func:`align`: segmentation, checks, estimator)
+jobs      the commands' jobs: `matrix` (log + plan -> result) and `apply` (result + log -> corrected log)
 result    its result (:class:`AlignmentResult`) and file
 
 Equations are those of M. Looney, "The Basics of MEMS IMU/Gyroscope Alignment",
 Analog Dialogue (reference ``alignment-basics.md``).
 """
 
-from align.alignment.job import AlignOptions, align
+from align.alignment.pipeline import AlignOptions, align
 from align.alignment.plan import Plan, Step
 from align.alignment.result import AlignmentResult
 from align.alignment.segment import Segment, SegmentOptions

@@ -207,8 +207,9 @@ def check_directions(measured: list[tuple[Segment, float, float]], plan: Plan, t
     HandednessError
         When every step about one axis, in both directions, is reversed (``det(M) < 0``).
     """
-    steps = [plan.steps[seg.step] for seg, _, _ in measured]
-    planned = np.array([s.rate if s.rate is not None else s.angle for s in steps])
+    steps = [plan.steps[seg.step] for seg, _, _ in measured if seg.step is not None]
+    assert len(steps) == len(measured), "every measured turn is a plan step"
+    planned = np.array([s.turn for s in steps])
     ratios = np.array([along for _, along, _ in measured]) / planned
     signed = planned * np.array([s.sign for s in steps])  # turn about the positive system axis
     hint = unit_mixup_hint(float(np.median(np.abs(ratios))))

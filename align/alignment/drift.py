@@ -11,8 +11,11 @@ combination ``sum_k c_k bbar_k`` of the segments' mean biases with ``sum_k c_k =
 with ``<.>_kl`` the mean over ``s`` in segment ``k`` and ``t`` in segment ``l`` (the generalised covariances of
 Brownian motion and of 1/f noise; closed forms in :func:`interval_means`). Two adjacent means over ``tau``
 differ by ``2 K^2 tau / 3`` and ``(4 ln 2 / pi) B^2``: twice the Allan variances. :func:`estimate_drift`
-measures ``K`` and ``B`` from the scatter of the static periods' means (Eq D4); :func:`with_drift` attaches the
-model to the observations and adds to each its mean bias' deviation from the session bias (Eq D3).
+measures ``K`` and ``B`` from the scatter of the static periods' means (Eq D4; one value shared by the three
+gyros unless a gyro's own is significantly better, Eq D5); :func:`with_drift` attaches the model to the
+observations and adds to each its mean bias' deviation from the session bias (Eq D3). Without a latitude the
+static periods also hold the Earth rate, constant but different between orientations (Eq O1-O3 of
+:mod:`align.alignment.observe`): its covariance is part of the samples' noise, so it is not read as a drift.
 
 The estimators' own error follows exactly from Eq D2 (:mod:`align.alignment.estimate`): a ``+/-`` pair's
 difference carries the bias change between its two segments, a turn its mean bias change times ``T``. The
@@ -130,17 +133,24 @@ def _span(o: Observation, t: np.ndarray) -> tuple[float, float]:
     return start, start + float(o.duration)
 
 
+def _earth(o: Observation) -> np.ndarray:
+    """The observation's shared, unmodelled Earth term (3, 3) (zeros when none; see :mod:`~align.alignment.observe`)."""
+    return np.zeros((3, 3)) if o.earth is None else np.asarray(o.earth, float)
+
+
 def _probes(observations: list[Observation], t: np.ndarray, sigma: np.ndarray | None, m: np.ndarray):
-    """Bias samples (value (3,), noise variance (3,), spans (j, 2), weights (j,)) and their source."""
+    """Bias samples (value (3,), noise variance (3,), spans (j, 2), weights (j,), shared Earth term (3, 3)) and
+    their source."""
     statics = sorted((o for o in observations if o.segment.kind == "static"), key=lambda o: o.segment.start)
     if len(statics) >= 2:
         out = []
         for o in statics:  # var: the noise inside, and the Earth rate observe could not model
             v = o.var if sigma is None else np.maximum(o.var, sigma**2 / o.segment.n)
-            out.append((o.y - m @ o.phi[:3], np.asarray(v, float), np.array([_span(o, t)]), np.ones(1)))
+            out.append((o.y - m @ o.phi[:3], np.asarray(v, float), np.array([_span(o, t)]), np.ones(1), _earth(o)))
         return out, "static periods"
     moving = sorted((o for o in observations if o.segment.kind != "static"), key=lambda o: o.segment.start)
-    out, taken = [], set()
+    taken: set[int] = set()
+    out = []
     for i, p in enumerate(moving):
         if i in taken:
             continue
@@ -152,7 +162,7 @@ def _probes(observations: list[Observation], t: np.ndarray, sigma: np.ndarray | 
                 total = p.phi[3] + n.phi[3]
                 value = (p.y + n.y - m @ (p.phi[:3] + n.phi[:3])) / total
                 out.append((value, (p.var + n.var) / total**2, np.array([_span(p, t), _span(n, t)]),
-                            np.array([p.phi[3], n.phi[3]]) / total))
+                            np.array([p.phi[3], n.phi[3]]) / total, (_earth(p) + _earth(n)) / total))
                 taken.update((i, j))
                 break
     return out, "pairwise biases"
@@ -163,9 +173,11 @@ _SHARES = np.linspace(0.0, 1.0, 21)
 _SIZES = np.concatenate([[0.0], np.geomspace(1e-6, 1e6, 241)])
 
 
-def _walk_flicker(incs: list[np.ndarray], noises: list[np.ndarray], basis: list[np.ndarray]) -> np.ndarray:
+def _walk_flicker(incs: list[np.ndarray], noises: list[np.ndarray], basis: list[np.ndarray]
+                  ) -> tuple[np.ndarray, np.ndarray]:
     """``(K^2, B^2) >= 0`` maximising the Gaussian likelihood of the increments ``d`` (Eq D4), shape (2, 4):
-    for each gyro alone (columns 0-2) and for the three sharing them (column 3).
+    for each gyro alone (columns 0-2) and for the three sharing them (column 3); and each gyro's gain in
+    ``-2 log L`` (3,) from its own values over the shared ones (Eq D5).
 
     ``cov = V + s ((1 - r) A_W / a_W + r A_F / a_F)`` over a grid of shares ``r`` and sizes ``s`` (``a`` scales
     each to the mean square increment); for each ``r`` the generalised eigenvectors of ``(A_r, V)`` make
@@ -176,7 +188,7 @@ def _walk_flicker(incs: list[np.ndarray], noises: list[np.ndarray], basis: list[
     ss = float(np.mean([d @ d for d in incs]))
     out = np.zeros((2, 4))
     if not ss > 0:
-        return out
+        return out, np.zeros(3)
     scale = np.array([ss / max(float(np.trace(b)), 1e-300) for b in basis])
     nll = np.zeros((len(_SHARES), 3, len(_SIZES)))
     for j, r in enumerate(_SHARES):
@@ -186,15 +198,24 @@ def _walk_flicker(incs: list[np.ndarray], noises: list[np.ndarray], basis: list[
             lam, u = eigh(a, v)
             den = 1.0 + _SIZES[:, None] * np.maximum(lam, 0.0)[None, :]
             nll[j, i] = np.sum(np.log(den) + (u.T @ d) ** 2 / den, axis=1)
+    best = []
     for i, curve in enumerate([nll[:, 0], nll[:, 1], nll[:, 2], nll.sum(axis=1)]):
-        j, k = np.unravel_index(np.argmin(curve), curve.shape)
+        j, k = (int(v) for v in np.unravel_index(np.argmin(curve), curve.shape))
         out[:, i] = _SIZES[k] * np.array([1 - _SHARES[j], _SHARES[j]]) * scale
-    return out
+        best.append((j, k))
+    j, k = best[3]
+    gain = np.array([nll[j, i, k] - nll[best[i][0], i, best[i][1]] for i in range(3)])
+    return out, gain
+
+
+#: Eq D5: a gyro's own drift replaces the shared one only beyond this gain in ``-2 log L`` (two more parameters,
+#: chi^2 with 2 degrees of freedom at 5 % over the three gyros tried: 1 - 0.05 / 3)
+OWN_DRIFT_GAIN = 8.19
 
 
 def _fit_walk_flicker(probes) -> tuple[np.ndarray, np.ndarray]:
-    """``K^2`` and ``B^2`` (each shape (3,)) from the probes' consecutive differences (Eq D4): each gyro's own
-    estimate or the shared one, whichever is larger."""
+    """``K^2`` and ``B^2`` (each shape (3,)) from the probes' consecutive differences (Eq D4): the shared estimate,
+    or, where a gyro's own fits its increments significantly better (Eq D5), the larger of the two term by term."""
     spans = np.vstack([p[2] for p in probes])
     m_abs, m_log = interval_means(spans)
     sizes = np.cumsum([0] + [len(p[3]) for p in probes])
@@ -205,10 +226,11 @@ def _fit_walk_flicker(probes) -> tuple[np.ndarray, np.ndarray]:
     basis = [diff @ (-0.5 * m_abs) @ diff.T, diff @ (-m_log / np.pi) @ diff.T]
     step = np.eye(len(probes))[:-1] - np.eye(len(probes), k=1)[:-1]
     values, noise = np.array([p[0] for p in probes]), np.array([p[1] for p in probes])
+    earth = np.array([p[4] for p in probes])  # (j, 3, 3): the Earth rate shared between probes is not a drift
     incs = [step @ values[:, i] for i in range(3)]
-    noises = [(step * noise[:, i]) @ step.T for i in range(3)]
-    both = _walk_flicker(incs, noises, basis)
-    out = np.maximum(both[:, :3], both[:, 3:])
+    noises = [step @ (np.diag(noise[:, i]) + earth[:, i] @ earth[:, i].T) @ step.T for i in range(3)]
+    both, gain = _walk_flicker(incs, noises, basis)
+    out = np.where(gain[None, :] > OWN_DRIFT_GAIN, np.maximum(both[:, :3], both[:, 3:]), both[:, 3:])
     return out[0], out[1]
 
 
@@ -216,15 +238,19 @@ def estimate_drift(observations: list[Observation], t: np.ndarray, sigma: np.nda
                    m: np.ndarray | None = None) -> Drift:
     """Measure the bias drift (Eq D1) from the scatter of the bias between segments (Eq D4).
 
-    The bias samples are the static periods' means ``y - M phi`` (at least two); without them, the
-    pairwise biases of ``+/-`` pairs (two dwells or turns with opposite ``phi``: ``(y+ + y-) / (T+ + T-)``,
-    each the mean over its two segments). Their consecutive differences ``d`` (free of the turn-on bias) are
-    Gaussian with the covariance ``V + K^2 A_W + B^2 A_F`` (``V`` the samples' noise, ``A`` Eq D2 for unit
-    ``K``, ``B``); ``K^2, B^2 >= 0`` maximise its likelihood (Eq D4, restricted maximum likelihood), for each
-    gyro and for the three together (sharing ``K``, ``B``). Each gyro keeps the larger of its own and the
-    shared value, term by term: a handful of static periods measures the drift only to tens of percent, and
-    an underestimate would make the uncertainties claim too much. With neither source the drift is zero and
-    the note says it was not measured.
+    The bias samples are the static periods' means ``y - M phi`` (at least two); without them, the pairwise biases
+    of ``+/-`` pairs (two dwells or turns with opposite ``phi``: ``(y+ + y-) / (T+ + T-)``, each the mean over its
+    two segments). Their consecutive differences ``d`` (free of the turn-on bias) are Gaussian with the covariance
+    ``V + K^2 A_W + B^2 A_F`` (``V`` the samples' noise and, without a latitude, the covariance of the Earth rate
+    they share, Eq O3 of :mod:`~align.alignment.observe`: a constant, not a drift; ``A`` Eq D2 for unit ``K``,
+    ``B``); ``K^2, B^2 >= 0`` maximise its likelihood (Eq D4, restricted maximum likelihood), for each gyro and for
+    the three together (sharing ``K``, ``B``). The gyros share the joint value unless one's own fits its increments
+    better by more than chance allows (Eq D5: ``-2 log L`` lower by more than :data:`OWN_DRIFT_GAIN`, the 5 % level
+    of chi^2 with 2 degrees of freedom over the three gyros tried): that gyro keeps the larger of its own and the
+    shared value, term by term, since a handful of static periods measures the drift only to tens of percent and an
+    underestimate would make the uncertainties claim too much. (Taking the larger one always claims a drift on a
+    drift-free gyro in about half the sessions of a few static periods, and a false drift spends what the dwells
+    hold.) With neither source the drift is zero and the note says it was not measured.
 
     Parameters
     ----------
@@ -313,5 +339,6 @@ def with_drift(observations: list[Observation], drift: Drift, t: np.ndarray,
         noise = o.noise_var if isinstance(o, DriftObservation) else o.var
         if sigma is not None and o.segment.kind != "angle":
             noise = np.maximum(noise - _within(span, drift), np.minimum(noise, sigma**2 / o.segment.n))
-        out.append(DriftObservation(o.segment, o.y, o.phi, noise + o.phi[3] ** 2 * d, o.duration, noise, span, drift))
+        out.append(DriftObservation(o.segment, o.y, o.phi, noise + o.phi[3] ** 2 * d, o.duration, noise, span, drift,
+                                    earth=o.earth))
     return out

@@ -11,7 +11,9 @@ shortcut (Eq 35-36).
 Each estimate is linear, ``x = L y`` (Eq E1), and its covariance is propagated through ``L`` (Eq E2): the
 noise inside the segments and, when the observations carry the bias-drift model
 (:class:`~align.alignment.drift.DriftObservation`, from :func:`~align.alignment.drift.with_drift`), the
-bias change between the segments (Eq D2); the bias is then the session bias, the mean of ``b(t)`` over the
+bias change between the segments (Eq D2), and without a latitude the Earth rate segments share (Eq O3 of
+:mod:`~align.alignment.observe`), both also in :func:`fit_lsq`'s weights (generalised least squares, Eq E4);
+the bias is then the session bias, the mean of ``b(t)`` over the
 samples of the segments used. When the residuals scatter more than the model predicts (Eq E3) the
 covariance is inflated by the ratio.
 
@@ -97,7 +99,11 @@ def condition_number(phi: np.ndarray) -> float:
 def fit_lsq(obs: list[Observation], rate_accuracy: float = 0.0, method: str = "lsq", equal_weights: bool = False) -> Fit:
     """General weighted least squares for ``[M | b]`` (extends Eq 28-31).
 
-    Each gyro ``i`` is fitted separately: minimise ``sum_k (y_ki - phi_k . x_i)^2 / var_ki``. The
+    Each gyro ``i`` is fitted separately: minimise ``sum_k (y_ki - phi_k . x_i)^2 / var_ki``; when the
+    observations carry the bias drift or a shared, unmodelled Earth rate (no latitude), generalised least squares
+    on the whole error covariance ``S = diag(noise) + D C G C^T D + E`` (Eq E4, :func:`_error_cov`:
+    ``W = S^-1``), so that segments whose biases move together (neighbours under a drift, segments sharing the
+    Earth rate along one table axis) are not weighted as if independent. The
     covariance is that of ``x = L y``, ``L = (Phi^T W Phi)^-1 Phi^T W`` (Eq E1-E2; ``(Phi^T W Phi)^-1`` without
     drift), inflated by ``chi2 / E[chi2]`` when that exceeds 1 (Eq E3; ``E[chi2] = dof`` without drift: the
     scatter between segments is larger than the noise and drift inside them); a stated relative table
@@ -141,8 +147,11 @@ def fit_lsq(obs: list[Observation], rate_accuracy: float = 0.0, method: str = "l
     errors = _errors(obs)
     for i in range(3):
         wts = 1.0 / var[:, i]
-        a = phi[:, active] * np.sqrt(wts)[:, None]
-        b = y[:, i] * np.sqrt(wts)
+        whiten = None if equal_weights else _whitening(_error_cov(phi, errors, i))
+        if whiten is None:
+            whiten = np.diag(np.sqrt(wts))
+        a = whiten @ phi[:, active]
+        b = whiten @ y[:, i]
         sol, *_ = np.linalg.lstsq(a, b, rcond=None)
         x[i, active] = sol
         resid[:, i] = y[:, i] - phi[:, active] @ sol
@@ -151,7 +160,7 @@ def fit_lsq(obs: list[Observation], rate_accuracy: float = 0.0, method: str = "l
             inflate = chi2[i] / dof if dof > 0 else np.nan
             cov[i][sub] = np.linalg.inv(a.T @ a) * inflate
         else:
-            lmap = np.linalg.solve(a.T @ a, a.T * np.sqrt(wts)[None, :])  # x = L y (Eq E1)
+            lmap = np.linalg.solve(a.T @ a, a.T @ whiten)  # x = L y (Eq E1)
             cov[i][sub] = _propagate(lmap, phi, active, var[:, i], resid[:, i], dof, errors, i)
     m = x[:, :3]
     if rate_accuracy:
@@ -161,15 +170,24 @@ def fit_lsq(obs: list[Observation], rate_accuracy: float = 0.0, method: str = "l
     return Fit(m, x[:, 3], sig[:, :3], sig[:, 3], cov, resid, dof, chi2, condition_number(phi[:, active]), method)
 
 
+def _whitening(cov: np.ndarray | None) -> np.ndarray | None:
+    """``W`` (k, k) with ``W^T W = cov^-1`` (the inverse Cholesky factor), or None for None."""
+    if cov is None:
+        return None
+    scale = np.sqrt(np.diag(cov))
+    chol = np.linalg.cholesky(cov / np.outer(scale, scale) + 1e-12 * np.eye(len(scale)))
+    return np.linalg.solve(chol, np.diag(1.0 / scale))
+
+
 def _pairs(obs: list[Observation], plan: Plan, kind: str) -> dict[int, tuple[Observation, Observation]]:
     """For each axis, the observation with positive and negative turn (Eq 28, 31)."""
     found: dict[int, dict[int, Observation]] = {}
     for o in obs:
         if o.segment.kind != kind:
             continue
+        assert o.segment.step is not None  # a rate or angle segment is a plan step
         step = plan.steps[o.segment.step]
-        value = step.rate if kind == "rate" else step.angle
-        found.setdefault(step.axis, {})[int(np.sign(value * step.sign))] = o
+        found.setdefault(step.axis, {})[int(np.sign(step.turn * step.sign))] = o
     pairs = {a: (d[1], d[-1]) for a, d in found.items() if 1 in d and -1 in d}
     missing = [axis_name(a) for a in range(3) if a not in pairs]
     if missing:
@@ -289,15 +307,40 @@ def _closed_form_fit(obs: list[Observation], m: np.ndarray, bias: np.ndarray, lm
     return Fit(m, bias, sig[:, :3], sig[:, 3], cov, resid, dof, chi2, condition_number(phi), method)
 
 
-def _errors(obs: list[Observation]) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
-    """The observations' noise variances (k, 3) and, when they carry a drift model (all
+def _errors(obs: list[Observation]) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None, np.ndarray | None]:
+    """The observations' noise variances (k, 3); when they carry a drift model (all
     :class:`~align.alignment.drift.DriftObservation`), its generalised covariance ``G`` (3, k, k) of the
-    segments' mean biases (Eq D2) and the session weights ``tau`` (k,), ``T_k / sum T``."""
-    if obs and all(isinstance(o, DriftObservation) for o in obs):
-        spans = np.array([o.span for o in obs])
+    segments' mean biases (Eq D2) and the session weights ``tau`` (k,), ``T_k / sum T``; when some carry a
+    shared, unmodelled Earth term (:mod:`~align.alignment.observe`, Eq O3), its covariance ``E`` (3, k, k)."""
+    shared = [o.earth for o in obs]
+    earth = None
+    if any(e is not None for e in shared):
+        b = np.array([np.zeros((3, 3)) if e is None else np.asarray(e, float) for e in shared])  # (k, 3, 3)
+        earth = np.einsum("kim,lim->ikl", b, b)
+    drifted = [o for o in obs if isinstance(o, DriftObservation)]
+    if obs and len(drifted) == len(obs):
+        spans = np.array([o.span for o in drifted])
         durations = spans[:, 1] - spans[:, 0]
-        return np.array([o.noise_var for o in obs]), obs[0].drift.covariance(spans), durations / durations.sum()
-    return np.array([o.var for o in obs]), None, None
+        return (np.array([o.noise_var for o in drifted]), drifted[0].drift.covariance(spans), durations / durations.sum(),
+                earth)
+    return np.array([o.var for o in obs]), None, None, earth
+
+
+def _error_cov(phi: np.ndarray, errors: tuple, i: int) -> np.ndarray | None:
+    """Covariance (k, k) of gyro ``i``'s observation errors about ``[M | b] phi`` with ``b`` the session bias (Eq E4):
+    ``diag(noise) + D C G C^T D + E`` (``D = diag(phi_3)``, ``C = I - 1 tau^T``; ``G`` Eq D2, ``E`` Eq O3), or None
+    when it is the diagonal the weights already hold (no drift, no shared Earth term)."""
+    noise, g, tau, earth = errors
+    if (g is None or not np.any(g[i])) and earth is None:
+        return None
+    cov = np.diag(noise[:, i])
+    if g is not None and np.any(g[i]):
+        c = (np.eye(len(tau)) - tau[None, :]) * phi[:, 3][:, None]
+        part = c @ g[i] @ c.T
+        cov = cov + (part + part.T) / 2
+    if earth is not None:
+        cov = cov + earth[i]
+    return cov
 
 
 def _propagate(lmap: np.ndarray, phi: np.ndarray, active: np.ndarray, var: np.ndarray, resid: np.ndarray, dof: int,
@@ -330,7 +373,7 @@ def _propagate(lmap: np.ndarray, phi: np.ndarray, active: np.ndarray, var: np.nd
     -------
     ndarray, shape (p, p)
     """
-    noise, g, tau = errors
+    noise, g, tau, earth = errors
     proj = np.eye(len(var)) - phi[:, active] @ lmap
     cov = (lmap * noise[:, i]) @ lmap.T
     r_var = np.einsum("kj,j,kj->k", proj, noise[:, i], proj)
@@ -340,6 +383,9 @@ def _propagate(lmap: np.ndarray, phi: np.ndarray, active: np.ndarray, var: np.nd
         cov = cov + a @ g[i] @ a.T
         pa = proj * phi[:, 3]
         r_var = r_var + np.einsum("kj,jl,kl->k", pa, g[i], pa)
+    if earth is not None:  # the Earth rate the segments share (Eq O3)
+        cov = cov + lmap @ earth[i] @ lmap.T
+        r_var = r_var + np.einsum("kj,jl,kl->k", proj, earth[i], proj)
     expect = float(np.sum(r_var / var))
     if dof > 0 and expect > 0:
         cov = cov * max(1.0, float(np.sum(resid**2 / var)) / expect)

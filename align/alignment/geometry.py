@@ -99,13 +99,15 @@ def parse_mounting(table: dict, where: str) -> np.ndarray:
         here = f"{where}.axes"
     else:
         here = f"{where}.matrix"
+        parsed: np.ndarray | None
         try:
-            n = np.array(table["matrix"], dtype=float)
+            parsed = np.array(table["matrix"], dtype=float)
         except (TypeError, ValueError):
-            n = None
-        if n is None or n.shape != (3, 3) or not np.isfinite(n).all():
+            parsed = None
+        if parsed is None or parsed.shape != (3, 3) or not np.isfinite(parsed).all():
             raise InputError("must be three rows of three numbers, e.g. [[0.866, 0.5, 0], [-0.5, 0.866, 0], [0, 0, 1]]",
                              here)
+        n = parsed
         off = float(np.abs(n @ n.T - np.eye(3)).max())
         if off > 5e-3:  # rounded entries (0.866, 0.5) pass; the nearest rotation is then used
             raise InputError(f"the rows are not perpendicular unit vectors (N N^T differs from the identity by {off:.2g}); "

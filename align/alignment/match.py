@@ -108,7 +108,9 @@ def _find(step: Step, cands: list[Candidate], pos: int, e: np.ndarray, tol: floa
 def _greedy(plan: Plan, cands: list[Candidate], n: np.ndarray, tol: float):
     """Match the steps in order under mounting ``n``: (ranges, used candidate indices, cost, first unmatched step,
     position reached, first departure ``(step, position)`` where a motion was skipped, or None)."""
-    pos, ranges, used, cost, departed = 0, [], set(), 0.0, None
+    ranges: list[tuple[int, int]] = []
+    used: set[int] = set()
+    pos, cost, departed = 0, 0.0, None
     for k, step in enumerate(plan.steps):
         found = _find(step, cands, pos, _expected(step, n), tol)
         if found is None:
@@ -167,6 +169,7 @@ def match_steps(plan: Plan, cands: list[Candidate], describe, where: str = "log"
         key = (missing is None, len(ranges) - 2 * (pos - len(used)) - prior, -cost)
         if best is None or key > best[0]:
             best = (key, n, ranges, used, missing, pos, departed)
+    assert best is not None  # at least one mounting hypothesis is always tried
     _, n, ranges, used, missing, pos, departed = best
     if missing is None:
         source = "declared" if declared is not None else "detected"
@@ -183,7 +186,7 @@ def _refuse_mixup(plan: Plan, sizes: list[float], where: str) -> None:
     if not sizes:
         return
     biggest = sorted(sizes)[-len(plan.steps):]
-    planned = [abs(s.rate if s.rate is not None else s.angle) for s in plan.steps]
+    planned = [abs(s.turn) for s in plan.steps]
     hint = unit_mixup_hint(float(np.median(biggest)) / float(np.median(planned)))
     if hint:
         raise TestError(hint, where)
@@ -193,7 +196,7 @@ def _refuse_mirrored(plan: Plan, cands: list[Candidate], proper: np.ndarray, tol
     """The nominal mounting (``proper``: the declared one or the identity) with one gyro reversed finds every step:
     that gyro reads backwards. Only said when the axis it measures was turned both ways (with one direction only, a
     turn the wrong way looks the same)."""
-    both = {a for a in range(3) if len({np.sign((s.rate if s.rate is not None else s.angle) * s.sign)
+    both = {a for a in range(3) if len({np.sign(s.turn * s.sign)
                                          for s in plan.steps if s.axis == a}) == 2}
     for i in range(3):
         flip = proper.copy()
@@ -207,14 +210,14 @@ def _refuse_mirrored(plan: Plan, cands: list[Candidate], proper: np.ndarray, tol
 
 def _refuse_unaligned(plan: Plan, cands: list[Candidate], where: str) -> None:
     """Steps found by size in order but along no single gyro: an IMU mounted at an angle, to be declared."""
-    sizes = {}
+    sizes: dict[int, list[np.ndarray]] = {}
     pos = 0
     for step in plan.steps:
-        want = abs(step.rate if step.rate is not None else step.angle)
+        want = abs(step.turn)
         for j in range(pos, len(cands)):
             if abs(np.linalg.norm(cands[j].vector) / want - 1) <= 0.1:
                 sizes.setdefault(step.axis, []).append(cands[j].vector / (want * np.sign(
-                    (step.rate if step.rate is not None else step.angle) * step.sign)))
+                    step.turn * step.sign)))
                 pos = j + 1
                 break
         else:
@@ -230,11 +233,11 @@ def _refuse_unaligned(plan: Plan, cands: list[Candidate], where: str) -> None:
         c = 3 - a - b
         cols[:, c] = np.cross(cols[:, (c + 1) % 3], cols[:, (c + 2) % 3])
     n = nearest_rotation(cols)
-    angle, axis, nominal = _round_rotation(n)
+    angle, about, nominal = _round_rotation(n)
     rows = ", ".join("[" + ", ".join(f"{v:.4f}" for v in row) + "]" for row in nominal)
     raise TestError(f"the turns are found but each moves several gyros: the IMU is mounted at an angle to the system "
                     f"axes (measured: {mounting_label(n)}); declare its nominal mounting in the plan (the nearest round "
-                    f"rotation is {angle:g} deg about {axis}: check it against the drawing), e.g. [mounting] matrix = "
+                    f"rotation is {angle:g} deg about {about}: check it against the drawing), e.g. [mounting] matrix = "
                     f"[{rows}]", where)
 
 
@@ -272,7 +275,7 @@ def _why(plan: Plan, k: int, cands: list[Candidate], pos: int, n: np.ndarray, de
     across = float(np.linalg.norm(v - along * e / np.linalg.norm(e)))
     seen = describe(cands[pos])
     unit = "deg/s" if step.rate is not None else "deg"
-    said = f"planned {format_quantity(step.rate if step.rate is not None else step.angle, unit, 5)} about " \
+    said = f"planned {format_quantity(step.turn, unit, 5)} about " \
            f"{axis_name(step.axis, step.sign)}"
     if across > 0.5 * abs(along):
         mount = "the declared mounting" if declared else f"the mounting {mounting_label(n)}"

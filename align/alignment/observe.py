@@ -20,6 +20,21 @@ local level frame (:func:`align.earth.earth_rate_enu`). What the plan's geometry
 * a static period after a motion the plan does not list: nothing modelled; ``Omega^2 / 3`` per axis enters
   the variance.
 
+Without a latitude (or with the correction switched off) nothing is modelled (``phi`` as above with
+``w_earth = 0``), but the Earth rate is still there: a constant vector ``Omega_L`` of size ``Omega`` and unknown
+direction (latitude and heading unknown), taken as isotropic, ``cov(Omega_L) = Omega^2 / 3 I`` (Eq O1). What the
+geometry says about it is kept, so that nothing downstream mistakes it for a bias drift
+(:mod:`align.alignment.drift`) or for noise that averages out:
+
+* the component along a table axis ``a``, ``Omega_L . a``, is the same in every dwell, turn and static period
+  with that axis: ``y_k`` holds ``E_k Omega_L`` with ``E_k = N u_k a^T`` (times ``T_k`` for a turn; ``u_k`` the
+  step's axis in the system frame); a static period with a stated rest holds ``E_k = N C^T`` (Eq O2). These
+  shared terms are the observation's ``earth`` (3, 3), scaled by ``Omega / sqrt(3)`` so that their covariance
+  is ``cov(y_k, y_l)_i = earth_k[i] . earth_l[i]`` per gyro ``i`` (Eq O3);
+* the part across the axis (size ``P``, ``E[P^2] = 2 Omega^2 / 3``) enters the variance as above (a static
+  period: ``Omega^2 / 3`` on each direction across the axis; a dwell or turn: the same times its turning
+  mean's fraction squared), and after a motion the plan does not list ``Omega^2 / 3`` per axis.
+
 Public names
 ------------
 Observation, EarthModel, observe
@@ -27,7 +42,9 @@ Observation, EarthModel, observe
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -53,6 +70,10 @@ class Observation(Value):
         Variance of ``y`` from the noise inside the segment (batch means for dwells, white noise for turns).
     duration : float
         s.
+    earth : ndarray, shape (3, 3), or None
+        Without a latitude: the unmodelled Earth rate ``y`` shares with other segments, ``E_k Omega / sqrt(3)``
+        (Eq O2; rad/s per unit of the isotropic Earth-rate direction, rad for a turn); per gyro ``i``
+        ``cov(y_k, y_l) = earth_k[i] . earth_l[i]`` (Eq O3). None when nothing is shared (keyword only).
     """
 
     segment: Segment
@@ -60,6 +81,7 @@ class Observation(Value):
     phi: np.ndarray
     var: np.ndarray
     duration: float
+    earth: np.ndarray | None = field(default=None, kw_only=True)
 
 
 #: smallest variance of an observation ((rad/s)^2 or rad^2): keeps noiseless data finite
@@ -131,16 +153,20 @@ def _static_geometry(seg: Segment, steps: list[Segment], moves: list[tuple[int, 
         return not any(a < e and s < b for s, e in moves)
 
     if after and clear(seg.end, after[0].start):
-        step = plan.steps[after[0].step]
+        k = after[0].step
+        assert k is not None  # ``steps`` holds the step segments only
+        step = plan.steps[k]
         return ("whole" if step.rest is not None else "along"), step
     if before and clear(before[-1].end, seg.start):
-        return "along", plan.steps[before[-1].step]
+        k = before[-1].step
+        assert k is not None
+        return "along", plan.steps[k]
     return "unknown", None
 
 
 def observe(t: np.ndarray, g: np.ndarray, segments: list[Segment], plan: Plan, sigma: np.ndarray,
             earth: bool = False, mounting: np.ndarray | None = None,
-            moves: list[tuple[int, int]] = ()) -> tuple[list[Observation], EarthModel]:
+            moves: Sequence[tuple[int, int]] = ()) -> tuple[list[Observation], EarthModel]:
     """Turn segments into linear observations (see module docstring).
 
     Parameters
@@ -155,7 +181,7 @@ def observe(t: np.ndarray, g: np.ndarray, segments: list[Segment], plan: Plan, s
         Model the Earth rate (needs ``plan.latitude``) as far as the plan's geometry allows.
     mounting : ndarray, shape (3, 3), optional
         The nominal mounting ``N`` (identity when None): which gyros an unmodelled part reaches.
-    moves : list of (int, int)
+    moves : sequence of (int, int)
         Sample ranges of the motions the plan does not list (after one, a rest orientation is unknown).
 
     Returns
@@ -170,27 +196,32 @@ def observe(t: np.ndarray, g: np.ndarray, segments: list[Segment], plan: Plan, s
     lat = plan.latitude if earth else None
     omega = earth_rate_enu(lat) if lat is not None else np.zeros(3)
     steps = [s for s in segments if s.step is not None]
-    out, model = [], {"steps": 0, "whole": 0, "along": 0, "unknown": 0, "across": 0.0}
-    along_rates = set()
+    out = []
+    model: dict[str, Any] = {"steps": 0, "whole": 0, "along": 0, "unknown": 0, "across": 0.0}
+    along_rates: set[float] = set()
     for seg in segments:
         x = g[seg.start : seg.end]
-        extra = np.zeros(3)
+        extra, shared = np.zeros(3), None
         if seg.kind == "angle":
+            assert seg.step is not None  # a turn is a plan step
             step = plan.steps[seg.step]
             y, duration = integrate(t, g, seg.start, seg.end)
             along = float(omega @ step.table_vector)
-            phi = np.append((step.angle + along * duration) * step.unit_axis, duration)
+            phi = np.append((step.turn + along * duration) * step.unit_axis, duration)
             var = sigma**2 * dt * duration
         else:
             duration = seg.n * dt
             y = x.mean(axis=0)
             var = np.maximum(_batch_mean_var(x), sigma**2 / seg.n)
             if seg.kind == "rate":
+                assert seg.step is not None  # a dwell is a plan step
                 step = plan.steps[seg.step]
                 along = float(omega @ step.table_vector)
-                phi = np.append((step.rate + along) * step.unit_axis, 1.0)
-            else:
+                phi = np.append((step.turn + along) * step.unit_axis, 1.0)
+            elif lat is not None:
                 phi, extra = _static_phi(seg, steps, list(moves), plan, omega, n_nom, model, along_rates)
+            else:
+                phi = np.array([0.0, 0.0, 0.0, 1.0])
         if seg.kind != "static" and lat is not None:
             across = float(np.linalg.norm(np.cross(omega, step.table_vector)))
             size = across * _turning_mean(t, g, seg, n_nom @ step.unit_axis) / (1.0 if seg.kind == "angle" else duration)
@@ -198,8 +229,38 @@ def observe(t: np.ndarray, g: np.ndarray, segments: list[Segment], plan: Plan, s
             model["steps"] += 1
             model["across"] = max(model["across"], size / (duration if seg.kind == "angle" else 1.0))
             along_rates.add(round(along, 15))
-        out.append(Observation(seg, y, phi, np.maximum(var + extra, _VAR_FLOOR), duration))
+        if lat is None:
+            shared, extra = _unmodelled(t, g, seg, duration, steps, list(moves), plan, n_nom)
+        out.append(Observation(seg, y, phi, np.maximum(var + extra, _VAR_FLOOR), duration, earth=shared))
     return out, EarthModel(lat, along_rate=tuple(sorted(along_rates)), **model)
+
+
+#: 1-sigma of each component of the isotropic Earth rate of unknown direction (Eq O1), rad/s
+_EARTH_SD = EARTH_RATE / np.sqrt(3.0)
+
+
+def _unmodelled(t: np.ndarray, g: np.ndarray, seg: Segment, duration: float, steps: list[Segment],
+                moves: list[tuple[int, int]], plan: Plan, n_nom: np.ndarray) -> tuple[np.ndarray | None, np.ndarray]:
+    """Without a latitude: the segment's shared Earth term ``earth`` (3, 3) (Eq O2-O3) and the variance (3,) of the
+    part it holds alone (across the table axis, or all of it after an unlisted motion)."""
+    if seg.kind == "static":
+        how, step = _static_geometry(seg, steps, moves, plan)
+        if how == "unknown":
+            return None, np.full(3, _EARTH_SD**2)
+        assert step is not None  # known geometry: the step along the table
+        if how == "whole":
+            rest = step.rest_matrix
+            assert rest is not None  # "whole": the step states its rest orientation
+            return n_nom @ rest.T * _EARTH_SD, np.zeros(3)
+        fraction = 1.0
+    else:
+        assert seg.step is not None  # not static: a plan step
+        step = plan.steps[seg.step]
+        fraction = _turning_mean(t, g, seg, n_nom @ step.unit_axis) / (1.0 if seg.kind == "angle" else duration)
+    scale = _EARTH_SD * (duration if seg.kind == "angle" else 1.0)
+    shared = np.outer(n_nom @ step.unit_axis, step.table_vector) * scale
+    # across: E[P^2] / 2 = Omega^2 / 3 per direction across the axis, times the turning mean's fraction squared
+    return shared, _across_var(np.sqrt(2.0) * _EARTH_SD * fraction, step.unit_axis, n_nom)
 
 
 def _static_phi(seg: Segment, steps: list[Segment], moves: list[tuple[int, int]], plan: Plan, omega: np.ndarray,
@@ -209,11 +270,14 @@ def _static_phi(seg: Segment, steps: list[Segment], moves: list[tuple[int, int]]
         return np.array([0.0, 0.0, 0.0, 1.0]), np.zeros(3)
     how, step = _static_geometry(seg, steps, moves, plan)
     model[how] += 1
-    if how == "whole":
-        return np.append(step.rest_matrix.T @ omega, 1.0), np.zeros(3)
     if how == "unknown":
         model["across"] = max(model["across"], EARTH_RATE)
         return np.array([0.0, 0.0, 0.0, 1.0]), np.full(3, EARTH_RATE**2 / 3)
+    assert step is not None  # known geometry: the step along the table
+    if how == "whole":
+        rest = step.rest_matrix
+        assert rest is not None  # "whole": the step states its rest orientation
+        return np.append(rest.T @ omega, 1.0), np.zeros(3)
     along = float(omega @ step.table_vector)
     across = float(np.linalg.norm(np.cross(omega, step.table_vector)))
     model["across"] = max(model["across"], across)

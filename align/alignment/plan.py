@@ -95,10 +95,17 @@ class Step:
         return u
 
     @property
+    def turn(self) -> float:
+        """The signed table rate (rate step, rad/s) or angle (angle step, rad): a step holds exactly one."""
+        value = self.rate if self.rate is not None else self.angle
+        assert value is not None, "a step turns the table by a rate or an angle"
+        return value
+
+    @property
     def label(self) -> str:
         if self.rate is not None:
             return f"{axis_name(self.axis, self.sign)} at {format_quantity(self.rate, 'deg/s', 5)}"
-        return f"{axis_name(self.axis, self.sign)} through {format_quantity(self.angle, 'deg', 5)}"
+        return f"{axis_name(self.axis, self.sign)} through {format_quantity(self.turn, 'deg', 5)}"
 
 
 @dataclass(frozen=True)
@@ -164,7 +171,7 @@ class Plan:
         mounting = None
         if "mounting" in data:
             n = parse_mounting(table(data, "mounting", where), f"{where}: mounting")
-            mounting = tuple(tuple(float(v) for v in row) for row in n)
+            mounting = tuple((float(row[0]), float(row[1]), float(row[2])) for row in n)
         lat = test.get("latitude")
         latitude = None if lat is None else parse_quantity(lat, "angle", f"{where}: test.latitude")
         if latitude is not None and abs(latitude) > np.pi / 2:
@@ -179,8 +186,9 @@ class Plan:
     def to_toml(self) -> str:
         """The plan as TOML text that :meth:`from_dict` reads back."""
         lines = []
-        if self.mounting is not None:
-            axes = mounting_axes(self.nominal)
+        nominal = self.nominal
+        if self.mounting is not None and nominal is not None:
+            axes = mounting_axes(nominal)
             lines.append("[mounting]")
             if axes is not None:
                 lines.append("axes = [" + ", ".join(f'"{a}"' for a in axes) + "]")
@@ -203,7 +211,7 @@ class Plan:
             if s.rate is not None:
                 lines.append(f'rate = "{format_quantity(s.rate, "deg/s", 12)}"')
             else:
-                lines.append(f'angle = "{format_quantity(s.angle, "deg", 12)}"')
+                lines.append(f'angle = "{format_quantity(s.turn, "deg", 12)}"')
             if s.table_axis != self.table_axis:
                 lines.append(f'table_axis = "{s.table_axis}"')
             if s.rest is not None and s.rest != self.rest:
@@ -247,7 +255,8 @@ def _rest(source: dict, default: tuple[str, str, str] | None, where: str) -> tup
     if "rest" not in source:
         return default
     rest_matrix(source["rest"], where)
-    return tuple(str(d).strip().lower() for d in source["rest"])
+    x, y, z = (str(d).strip().lower() for d in source["rest"])
+    return x, y, z
 
 
 def _step(item: dict, here: str, table_axis: str = "up", rest: tuple[str, str, str] | None = None) -> Step:

@@ -8,6 +8,7 @@ AlignmentResult, SegmentReport, FILE_KEYS, FORMAT, FORMAT_VERSION
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 
@@ -188,7 +189,9 @@ class AlignmentResult(Result, format=FORMAT, version=FORMAT_VERSION, convention=
                 mounting_source=str(d.get("mounting", {}).get("source", "identity")),
                 motions=tuple(Motion(mo["name"], mo["kind"], int(mo["start"]), int(mo["end"]), float(mo["t_start"]),
                                      float(mo["t_end"]), float(mo["value"]) * (f if mo["kind"] == "rate" else DEG),
-                                     tuple(float(v) for v in mo["axis"]), str(mo["label"]))
+                                     # three numbers as to_dict writes them (the length is not checked here)
+                                     cast("tuple[float, float, float]", tuple(float(v) for v in mo["axis"])),
+                                     str(mo["label"]))
                               for mo in d.get("motions", [])),
             )
         except (KeyError, TypeError, ValueError) as exc:

@@ -198,7 +198,7 @@ def _split_static(g: np.ndarray, runs: list[tuple[int, int]], plan: Plan,
     ref = means[int(np.argmin(np.linalg.norm(means, axis=1)))]
     threshold = opts.static_threshold
     if plan.kind == "rate":
-        slowest = min(abs(s.rate) for s in plan.steps)
+        slowest = min(abs(s.turn) for s in plan.steps)
         threshold = min(threshold, 0.25 * slowest)
         if np.linalg.norm(ref) >= 0.5 * slowest:
             return [], list(runs)
@@ -221,7 +221,8 @@ def _turns(t: np.ndarray, g: np.ndarray, statics: list[tuple[int, int]], sigma: 
     ``max(1 deg, 10 sigma sqrt(dt T))`` (a static period split in two is not a turn).
     """
     dt = float(np.median(np.diff(t)))
-    pieces = [(None, statics[0])] if head and statics and statics[0][0] > 0 else []
+    pieces: list[tuple[tuple[int, int] | None, tuple[int, int]]] = (
+        [(None, statics[0])] if head and statics and statics[0][0] > 0 else [])
     pieces += list(zip(statics[:-1], statics[1:]))
     out = []
     for before, after in pieces:
@@ -328,7 +329,7 @@ def segment_log(
     bias = _static_bias(g, statics)
     turns = _turns(t, g, statics, sigma, head=plan.kind == "angle")
     if plan.kind == "rate":
-        moving = _merge_similar(g, moving, 0.08 * min(abs(s.rate) for s in plan.steps), int(fs))
+        moving = _merge_similar(g, moving, 0.08 * min(abs(s.turn) for s in plan.steps), int(fs))
         cands = [Candidate("rate", a, b, np.mean(g[a:b], axis=0) - bias) for a, b in moving]
     else:
         cands = turns
@@ -382,7 +383,8 @@ def segments_from_ranges(ranges: dict, plan: Plan, n: int, where: str = "segment
     ``start`` and ``end`` (integers, ``0 <= start < end <= n``); ranges must not
     overlap.
     """
-    segs, k = [], 0
+    segs: list[Segment] = []
+    k = 0
     for name, rng in ranges.items():
         a, b = _sample_range(str(name), rng, n, where)
         for other in segs:

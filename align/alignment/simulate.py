@@ -28,6 +28,7 @@ mounting_from_rotation, SimulationTruth
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 
@@ -134,7 +135,7 @@ def _check_size(plan: Plan, spec: SessionSpec) -> None:
         if step.rate is not None:
             seconds += spec.dwell_s + 2 * abs(step.rate) * (1 + abs(spec.table_rate_error)) / spec.accel
         else:
-            total = abs(step.angle) * (1 + abs(spec.table_angle_error))
+            total = abs(step.turn) * (1 + abs(spec.table_angle_error))
             seconds += total / min(spec.turn_rate, np.sqrt(total * spec.accel)) + 2 * spec.turn_rate / spec.accel
     if spec.reorient:  # a move of at most half a turn, and a gap after it, before each step but the first
         move = np.pi / min(spec.move_rate, np.sqrt(np.pi * spec.accel)) + 2 * spec.move_rate / spec.accel
@@ -225,7 +226,7 @@ def _simulate(plan: Plan, model: SensorModel, spec: SessionSpec, seed) -> dict:
         bias = bias + np.cumsum(rng.standard_normal((n, 3)) * spec.bias_walk * np.sqrt(dt), axis=0)
     white = rng.standard_normal((n, 3)) * spec.noise_density * np.sqrt(spec.fs)
     if spec.flicker > 0:
-        flicker = flicker_fft if n <= FFT_FLICKER_SAMPLES else (lambda *a: flicker_gm(*a, bank=12))
+        flicker = flicker_fft if n <= FFT_FLICKER_SAMPLES else partial(flicker_gm, bank=12)
         bias = bias + flicker(n, spec.fs, spec.flicker, rng, 3)
     g = w @ model.M.T + bias + white
     if spec.gyro_range is not None:

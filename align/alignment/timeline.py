@@ -128,7 +128,7 @@ class Timeline:
         body = c_from.T @ axis
         start = self.n
         self.add("move", rate, c_from, axis, body)
-        self.moves.append(Move(start, self.n, start * self.dt, self.n * self.dt, tuple(float(v) for v in body),
+        self.moves.append(Move(start, self.n, start * self.dt, self.n * self.dt, (float(body[0]), float(body[1]), float(body[2])),
                                angle, float(np.abs(rate).max())))
         self.static(self.spec.static_s, c_to)
 

@@ -157,7 +157,7 @@ def session_intervals(t: np.ndarray, a: np.ndarray, spec: dict | None, detector:
     if spec is not None:
         parsed = parse_positions(positions_of(spec, positions_file), positions_file)
         if parsed[0].samples is not None:
-            return [p.samples for p in parsed]
+            return [p.samples for p in parsed if p.samples is not None]  # the file gives every one or none
     fs = 1.0 / float(np.median(np.diff(t)))
     return static_intervals(a, fs, detector.window_s, detector.factor, detector.init_static_s, detector.min_static_s)
 
@@ -199,15 +199,16 @@ def accel_session(t: np.ndarray, a: np.ndarray, intervals: list, positions: list
         if not intervals:
             raise TestError("no static intervals detected: adjust the static detector ({factor}, {window_s}) "
                             "or list the positions", where)
-        ranges = {f"interval {k + 1}": r for k, r in enumerate(intervals)}
-        check_at_rest(norms_at_rest(a, ranges), gravity, units, "units", where)
-        means = static_means(a, ranges, 0.02, f"{where}: ")
+        detected = {f"interval {k + 1}": r for k, r in enumerate(intervals)}
+        check_at_rest(norms_at_rest(a, detected), gravity, units, "units", where)
+        means = static_means(a, detected, 0.02, f"{where}: ")
         cal = calibrate_accel_free(np.array(list(means.values())), gravity, units, where=where)
         note = f"{len(intervals)} static intervals detected automatically (moving variance)"
         return cal.replace(notes=cal.notes + (note,))
     parsed = parse_positions(positions, positions_file)
+    ranges: list[tuple[int, int]]  # the positions' sample ranges, in order
     if parsed[0].samples is not None:
-        ranges = [p.samples for p in parsed]
+        ranges = [p.samples for p in parsed if p.samples is not None]  # the file gives every one or none
     else:
         if len(intervals) != len(parsed):
             found = "; ".join(f"t={t[s]:.1f}-{t[e - 1]:.1f} s" for s, e in intervals[:20])

@@ -30,6 +30,14 @@ instead, so the matrix stays a rotation there). The axis found is the axis of
 the turn: turning on a flat surface makes it the face's normal whatever the
 table's tilt; a device turned by hand about the vertical gives the vertical,
 and the tilt of its axis from the vertical is an error the 1-sigma cannot hold.
+With the accelerometer's readings of all three captures the lean is measured and
+taken out (issue 23): each turn's axis in the accelerometer frame ``d_i``
+(:func:`accel_turn_axis`, A1: the normal of the circle gravity traces in the
+body frame, or, when it stands still, the down direction) is the target of the
+row ``R_i`` instead of the body axis ``e_i``, and the misalignment is the
+rotation taking every ``R_i`` onto its ``d_i`` (A2, Wahba's problem; with
+``d_i = e_i`` the nearest rotation to the rows, as before); a lean beyond
+:data:`LEAN_WARN` is warned of.
 
 ``R = [R_x; R_y; R_z]`` is a rotation up to noise (the symmetric soft iron
 leaves no shear); the result is its nearest rotation (``U V^T`` of the SVD),
@@ -48,7 +56,8 @@ wired backwards); an accelerometer that says the axis was not down.
 
 Public names
 ------------
-AXES, MIN_SAMPLES, TurnAxis, parse_axis_down, axis_down_captures, turn_axis, with_axis_down
+AXES, MIN_SAMPLES, LEAN_WARN, TurnAxis, parse_axis_down, axis_down_captures, turn_axis, accel_turn_axis, with_axis_down
+(LEAN_WARN and accel_turn_axis from :mod:`align.calibration.axislean`)
 """
 
 from __future__ import annotations
@@ -60,6 +69,7 @@ from pathlib import Path
 
 import numpy as np
 
+from align.calibration.axislean import LEAN_WARN, accel_turn_axis, angles_onto, lean_notes, rotation_onto  # noqa: F401
 from align.errors import InputError, TestError, literal
 from align.units import DEG, to_unit
 
@@ -268,17 +278,6 @@ def turn_axis(m_cal: np.ndarray, axis: str, field: float, units: str, where: str
     return TurnAxis(normal, float(normal @ mu), cov, noise, arc)
 
 
-def _rotation(rows: np.ndarray) -> np.ndarray:
-    u, _, vt = np.linalg.svd(rows)
-    return u @ vt
-
-
-def _angles(rows: np.ndarray) -> np.ndarray:
-    from scipy.spatial.transform import Rotation
-
-    return Rotation.from_matrix(_rotation(rows)).as_rotvec()
-
-
 def _check_vertical(turns: dict[str, TurnAxis], field: float, units: str, where: str) -> None:
     v = np.array([turns[a].vertical for a in AXES])
     mid = float(np.median(v))
@@ -315,7 +314,8 @@ def with_axis_down(cal, captures: dict, acc: dict | None = None, sources: dict |
     captures : dict
         ``{"x": raw (n, 3), "y": ..., "z": ...}``: raw readings of each turn, SI or counts as ``cal``.
     acc : dict, optional
-        Simultaneous accelerometer readings per axis (any unit): checked to show the axis down.
+        Simultaneous accelerometer readings per axis (any unit), (n_i, 3) each: checked to show the axis down
+        (within :data:`MAX_TILT`); with all three, each turn's axis from them is its row's target (A1-A2).
     sources : dict, optional
         Per axis, what the capture is (a file name, ``"LOG samples 100:900"``), for messages and notes.
     where : str
@@ -342,6 +342,10 @@ def with_axis_down(cal, captures: dict, acc: dict | None = None, sources: dict |
         if acc is not None and acc.get(a) is not None:
             _check_gravity(acc[a], a, sources[a])
     field, units = cal.field, cal.units
+    # A1: each turn's axis in the accelerometer frame, the target of its row (the body axes without all three)
+    seen = {a: accel_turn_axis(acc[a]) for a in AXES} if acc is not None and all(
+        acc.get(a) is not None for a in AXES) else None
+    targets = None if seen is None else np.array([seen[a][0] for a in AXES])
 
     def fit(h, w):
         return {a: turn_axis((raw[a] - h) @ w.T, a, field, units, sources[a]) for a in AXES}
@@ -349,16 +353,21 @@ def with_axis_down(cal, captures: dict, acc: dict | None = None, sources: dict |
     turns = fit(cal.hard_iron, cal.soft_iron)
     _check_vertical(turns, field, units, ", ".join(dict.fromkeys(sources.values())))
     rows = np.array([turns[a].axis for a in AXES])
-    # 1 sigma: the plane fits' noise, then the calibration's (h, W) covariance, propagated linearly
-    jac_rows = np.zeros((3, 9))
+    # 1 sigma: the plane fits' noise (and the accelerometer's axes'), then the calibration's (h, W) covariance
+    jac_rows, jac_targets = np.zeros((3, 9)), np.zeros((3, 9))
     for k in range(9):
         d = np.zeros(9)
         d[k] = 1e-7
-        jac_rows[:, k] = (_angles(rows + d.reshape(3, 3)) - _angles(rows - d.reshape(3, 3))) / 2e-7
-    cov_rows = np.zeros((9, 9))
+        step = d.reshape(3, 3)
+        jac_rows[:, k] = (angles_onto(rows + step, targets) - angles_onto(rows - step, targets)) / 2e-7
+        if targets is not None:
+            jac_targets[:, k] = (angles_onto(rows, targets + step) - angles_onto(rows, targets - step)) / 2e-7
+    cov_rows, cov_targets = np.zeros((9, 9)), np.zeros((9, 9))
     for i, a in enumerate(AXES):
         cov_rows[3 * i:3 * i + 3, 3 * i:3 * i + 3] = turns[a].cov
-    cov = jac_rows @ cov_rows @ jac_rows.T
+        if seen is not None:
+            cov_targets[3 * i:3 * i + 3, 3 * i:3 * i + 3] = seen[a][1]
+    cov = jac_rows @ cov_rows @ jac_rows.T + jac_targets @ cov_targets @ jac_targets.T
     notes = []
     if cal.covariance is not None:
         iu = np.triu_indices(3)
@@ -368,23 +377,21 @@ def with_axis_down(cal, captures: dict, acc: dict | None = None, sources: dict |
             sd = float(np.sqrt(cal.covariance[k, k]))
             if not sd > 0:
                 continue
-            step = 0.1 * sd
+            delta = 0.1 * sd
             out = []
             for sign in (1, -1):
                 p = base.copy()
-                p[k] += sign * step
+                p[k] += sign * delta
                 w = np.zeros((3, 3))
                 w[iu] = p[3:]
                 w = w + np.triu(w, 1).T
-                out.append(_angles(np.array([t.axis for t in fit(p[:3], w).values()])))
-            jac_cal[:, k] = (out[0] - out[1]) / (2 * step)
+                out.append(angles_onto(np.array([t.axis for t in fit(p[:3], w).values()]), targets))
+            jac_cal[:, k] = (out[0] - out[1]) / (2 * delta)
         cov = cov + jac_cal @ cal.covariance @ jac_cal.T
     else:
         notes.append("axis-down misalignment: the calibration has no covariance (an older file); its 1-sigma holds "
                      "the turns' noise only")
-    if acc is not None:
-        notes.append("the accelerometer showed each axis down; the rotation to the accelerometer frame from gravity "
-                     "is not computed: the axis-down turns give the rotation to the body (fixture) axes")
+    notes += lean_notes(targets, acc is not None)
     sigma = np.sqrt(np.diag(cov))
     skew = max(abs(np.arcsin(np.clip(rows[i] @ rows[j], -1, 1))) for i, j in ((0, 1), (0, 2), (1, 2)))
     vert = ", ".join(f"{a} {to_unit(turns[a].vertical, units):+.4g}" for a in AXES)
@@ -395,5 +402,5 @@ def with_axis_down(cal, captures: dict, acc: dict | None = None, sources: dict |
         "axis-down turns: " + "; ".join(f"{a} from {sources[a]}" for a in AXES)
         + f"; vertical field {vert} {units}; headings covered {arcs} deg; rows orthogonal within {skew / DEG:.3f} deg",
     ]
-    return cal.replace(misalignment=_rotation(rows), misalignment_method="axis-down", sigma_misalignment=sigma,
+    return cal.replace(misalignment=rotation_onto(rows, targets), misalignment_method="axis-down", sigma_misalignment=sigma,
                        notes=tuple(cal.notes) + tuple(notes))

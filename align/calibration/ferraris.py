@@ -127,7 +127,8 @@ def ferraris(acc: np.ndarray, gyr: np.ndarray, fs: float, sections: dict, turn_a
                      "vertical Earth rate, which changes sign between the faces")
     plan = Plan(tuple(Step(i, 1, angle=turn_angle) for i in range(3)))
     segs = [Segment(f, "static", *sections[f]) for f in FACES]
-    segs += [Segment(f"{a}_rot", "angle", *sections[f"{a}_rot"], step=i) for i, a in enumerate("xyz")]
+    segs += [Segment(f"{a}_rot", "angle", sections[f"{a}_rot"][0], sections[f"{a}_rot"][1], step=i)
+             for i, a in enumerate("xyz")]
     r = align(t, g, plan, AlignOptions(method="lsq", min_dwell=0.5, scale_tolerance=0.2), segs, gyr_units, "gyroscope")
     notes += ["gyro: Eq 31 on the integrated turns, bias from the static faces (weighted least squares)",
               "Earth rate not modelled: its vertical part differs between opposite faces and lands in K_ga (or, "
@@ -156,8 +157,9 @@ def sections_from_dict(raw: dict, where: str = "sections") -> dict[str, tuple[in
         if not isinstance(v, dict):
             raise InputError(literal('each section needs integer start and end, e.g. {"start": 540, "end": 1271}'), at)
         check_keys(v, ("start", "end"), at)
-        ends = [v.get("start"), v.get("end")]
-        if not all(isinstance(x, int) and not isinstance(x, bool) for x in ends):
+        start, end = v.get("start"), v.get("end")
+        if not (isinstance(start, int) and not isinstance(start, bool) and isinstance(end, int)
+                and not isinstance(end, bool)):
             raise InputError("each section needs integer start and end (samples, end exclusive)", at)
-        out[str(name)] = (ends[0], ends[1])
+        out[str(name)] = (start, end)
     return out

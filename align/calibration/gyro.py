@@ -9,7 +9,8 @@ free rotations about varied axes (by hand or on a simple fixture). The steps:
    pose 1 ends with it), or poses given as sample ranges.
 2. Accelerometer ``[M | b]`` from ``|a| = g`` over the poses' means
    (:func:`align.calibration.accel.calibrate_accel_free`): ``M_a`` upper triangular, which fixes the
-   accelerometer frame ``c`` (x along the accelerometer's x axis, y in its x-y plane).
+   accelerometer frame ``c`` (z along the accelerometer's z axis, y in its y-z plane: row 3 of ``M_a`` is
+   ``(0, 0, u33)``, row 2 ``(0, u22, u23)``).
 3. Gyro bias: the mean over the initial static period (pose 1), Earth's rate ignored.
 4. Gyro ``M`` (``g = M w + b``, 9 parameters) by least squares on the gravity directions after
    integrating each rotation (:mod:`align.calibration.gyrofit`, equation G1), with 1-sigma,
@@ -57,7 +58,7 @@ from align.values import Value
 #: a condition number above this: the rotations do not span 3-D (refused)
 SINGULAR_CONDITION = 1000.0
 METHOD = "rotations between static poses (imu_tk: gravity directions after integration)"
-FRAME_NOTE = ("relative to the accelerometer frame (x along the accelerometer's x axis, y in its x-y plane): gravity "
+FRAME_NOTE = ("relative to the accelerometer frame (z along the accelerometer's z axis, y in its y-z plane): gravity "
               "gives no reference about the vertical, so the rotation to the case or system is not observed; combine "
               "with a rate-table result or a mounting to express it in the system frame")
 
@@ -287,7 +288,8 @@ def _gyro_calibration(fit: GyroFit, off: _Offsets, units: str, rotations: list, 
                       seen: str) -> Calibration:
     """The gyro's Calibration: residuals per rotation as the mean reading error that explains them,
     ``M r_k / T_k`` (readings), the left-out rotations as checks."""
-    fitted, checks = {}, {}
+    fitted: dict[str, np.ndarray] = {}
+    checks: dict[str, np.ndarray] = {}
     for rep, r in zip(rotations, fit.residuals):
         reading = fit.M @ r / max(rep.t_end - rep.t_start, 1e-9)
         (fitted if rep.used else checks)[f"rotation {rep.number}"] = reading

@@ -287,6 +287,7 @@ def fit_gyro_matrix(t: np.ndarray, g: np.ndarray, spans: list, dirs: np.ndarray,
         grad = problem.direction_jacobian(m)
         extra += grad @ dir_cov @ grad.T
     if offsets is not None:
+        assert offset_cov is not None, "offsets come with their covariance offset_cov"
         steps = 1e-3 * np.sqrt(np.maximum(np.diag(offset_cov), 1e-300))
         grad = np.stack([(problem.resid(sol.x, problem.split(problem.g - h * o[problem.lo:problem.hi + 1])) - sol.fun)
                          / h for o, h in zip(offsets, steps)], axis=1)

@@ -1,7 +1,10 @@
 """A multi-position calibration turned into the system frame, from a rate-table result or a mounting.
 
 The multi-position calibration (:mod:`align.calibration.gyro`) finds both sensors relative to the
-accelerometer frame ``c``: ``g = M_g w_c + b_g``, ``a = M_a f_c + b_a``. The system frame ``s`` is
+accelerometer frame ``c``: ``g = M_g w_c + b_g``, ``a = M_a f_c + b_a`` with ``M_a`` upper triangular, so that
+``c`` has its z axis along the accelerometer's z axis and its y axis in the accelerometer's y-z plane (row 3 of
+``M_a`` is ``(0, 0, u33)``, row 2 ``(0, u22, u23)``; with a non-orthogonal accelerometer this is not the frame
+with x along the accelerometer's x axis). The system frame ``s`` is
 related to ``c`` by a rotation ``R`` (``w_c = R w_s``), which gravity cannot give. Combining means::
 
     M_g,s = M_g R,   M_a,s = M_a R   (biases unchanged)                              (F1)
@@ -183,8 +186,8 @@ def in_system_frame(acc: Calibration, gyr: Calibration, table_m: np.ndarray | No
         if worst > WARN_SIGMA:
             how += (f"; warning: that difference is {worst:.3g} sigma (more than {WARN_SIGMA:g}): the two calibrations "
                     "disagree beyond their uncertainty (another model, temperature, or not one gyro)")
-        acc_args = (got["dr"], got["var"], None)
-        gyr_args = (got["dr"], got["var"], slice(0, 9))
+        acc_args: tuple[np.ndarray | None, np.ndarray | None, slice | None] = (got["dr"], got["var"], None)
+        gyr_args: tuple[np.ndarray | None, np.ndarray | None, slice | None] = (got["dr"], got["var"], slice(0, 9))
     else:
         r = np.asarray(mounting, float)
         how = f"the frame from the mounting {source}: R = N, the accelerometer frame taken as the sensor axes"

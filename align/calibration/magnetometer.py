@@ -188,15 +188,19 @@ class MagCalibration(Result, format=FORMAT, convention=CONVENTION, version=2):
         }
         if self.covariance is not None:
             k = np.r_[np.full(3, to_unit(1.0, u)), np.ones(6)]
-            d["uncertainty"]["soft_iron"] = self.sigma_soft_iron.tolist()
+            sigma_soft = self.sigma_soft_iron
+            assert sigma_soft is not None  # given with the covariance
+            d["uncertainty"]["soft_iron"] = sigma_soft.tolist()
             d["uncertainty"]["covariance"] = (self.covariance * np.outer(k, k)).tolist()
             d["uncertainty"]["covariance_is"] = COVARIANCE_IS
         if self.misalignment is not None:
+            angles = self.misalignment_angles
+            assert angles is not None  # given with the misalignment
             d["misalignment"] = self.misalignment.tolist()
             d["misalignment_convention"] = "m_body = misalignment m_cal"
             d["misalignment_method"] = self.misalignment_method
             d["misalignment_angles"] = {
-                "angles_deg": (self.misalignment_angles / DEG).tolist(),
+                "angles_deg": (angles / DEG).tolist(),
                 "sigma_deg": None if self.sigma_misalignment is None else (self.sigma_misalignment / DEG).tolist(),
                 "angles_are": ANGLES_ARE}
         d["inputs"] = self.inputs
@@ -329,7 +333,7 @@ def calibrate_magnetometer(m: np.ndarray, units: str = "uT", field: float | None
     t_jac = np.column_stack([(final(p + dv) - final(p - dv)) / (2 * dv[k]) for k, dv in enumerate(np.diag(step))])
     cov = t_jac @ cov_p @ t_jac.T
     hard, w = c0 + p[:3] * s0, unpack(final(p)[3:], "symmetric")
-    field_si = s0 / np.linalg.det(unpack(p[3:], model)) ** (1 / 3) if target is None else field
+    field_si = s0 / np.linalg.det(unpack(p[3:], model)) ** (1 / 3) if field is None else field  # target None: field None
     if not np.all(np.linalg.eigvalsh(w) > 0) or np.linalg.det(w) <= 0:
         raise TestError("the soft-iron matrix is not positive definite (a reflected or degenerate solution); "
                         "the capture does not determine it", where)

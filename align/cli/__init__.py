@@ -22,7 +22,8 @@ Modules
 options    shared option types and their domains, the field -> flag table, old spellings
 paths      output checks before the work, the run's all-or-none outputs
 progress   the progress bar of long jobs
-alignment  matrix, apply, simulate
+alignment  matrix, apply
+simulate   simulate session | poses | lot
 mechanics  budget, allowable, check
 noise      allan, plan
 parts      parts
@@ -39,7 +40,7 @@ import difflib
 import functools
 import os
 import sys
-from typing import Annotated
+from typing import Annotated, Protocol, cast
 
 import typer
 
@@ -73,15 +74,17 @@ def _root(
     pass
 
 
-_MODULES = (alignment, simulate, mechanics, parts, noise, navigation, story, exports, batch)
+_MODULES = (alignment, mechanics, parts, noise, navigation, story, exports, batch)
 for _module in _MODULES:
     for _name, _command in _module.COMMANDS.items():
         app.command(_name)(_command)
+app.add_typer(simulate.app, name="simulate")
 app.add_typer(calibrate.app, name="calibrate")
 
 #: command -> its subcommands (empty: a command)
 COMMANDS: dict[str, tuple[str, ...]] = {
     **{name: () for m in _MODULES for name in m.COMMANDS},
+    "simulate": tuple(simulate.COMMANDS),
     "calibrate": tuple(calibrate.COMMANDS),
 }
 
@@ -159,6 +162,12 @@ def _given(param, args: list[str]) -> str | None:
     return None
 
 
+class _UsageError(Protocol):
+    """What click's and typer's usage errors (both copies) offer that is read here."""
+
+    def format_message(self) -> str: ...
+
+
 def _usage_message(exc: Exception, path: list[str], args: list[str]) -> str:
     """What a usage error says, from the exception's public attributes (click's or typer's own copy)."""
     kinds = {c.__name__ for c in type(exc).__mro__}
@@ -166,11 +175,12 @@ def _usage_message(exc: Exception, path: list[str], args: list[str]) -> str:
     if "MissingParameter" in kinds and param is not None:
         kind = "argument" if getattr(param, "param_type_name", "") == "argument" else "option"
         return f"missing {kind} {_flag(param)}"
-    if "NoSuchOption" in kinds and getattr(exc, "option_name", None):
+    option = getattr(exc, "option_name", None)
+    if "NoSuchOption" in kinds and option:
         known = [o for p in _params(path) if not getattr(p, "hidden", False)
                  for o in getattr(p, "opts", []) + getattr(p, "secondary_opts", []) if o.startswith("--")]
-        return _unknown("option", exc.option_name, known + ["--help"])
-    text = (getattr(exc, "message", None) or exc.format_message()).strip()
+        return _unknown("option", option, known + ["--help"])
+    text = (getattr(exc, "message", None) or cast(_UsageError, exc).format_message()).strip()
     text = text.removeprefix("Value error, ").rstrip(".")
     if "BadParameter" in kinds and param is not None:
         given = _given(param, args)
@@ -259,6 +269,7 @@ def _say(line: str) -> None:
 def _run(args: list[str], debug: bool) -> int:
     from align.errors import AlignError
 
+    args = simulate.old_spelling(args)  # today's `simulate DIR [--kind poses | --lot N]`
     path, problem = _command_path(args)
     if problem:
         return _fail(path, problem)

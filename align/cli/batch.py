@@ -1,11 +1,13 @@
 """``imu-align batch`` and ``imu-align lot``: many units through the single commands, and their statistics.
 
-``batch`` runs every unit of a manifest (:mod:`align.production.manifest`) through the very command
-a user would type for it alone: a worker calls :func:`align.cli.run` in its own process with the
-unit's words (``matrix LOG --plan PLAN ... --json OUT/units/SERIAL.JOB.json``), its output captured, and
-records the exit status and the command's one-line error against the serial; the unit's JSON,
-written atomically by the command itself, is read back for the lot's table. No job is run any
-other way, so a unit's result and its refusal are exactly the single command's.
+``batch`` runs every unit of a manifest (:mod:`align.production.manifest`) through the library job of
+the command a user would type for it alone: each row's words are parsed by that command and made into
+the job's options by the command's own builder, in this process, when the manifest is read
+(:mod:`align.cli.batchjobs`); a worker then runs the job (:func:`align.production.run_job`), writes the
+unit's JSON and the extra files its output options ask for, and returns the lot's rows from the result
+in memory. A unit's refusal is the single command's one line and exit status
+(:func:`align.cli.batchjobs.error_line`), so a unit's result and its refusal are exactly the single
+command's.
 
 Public names
 ------------
@@ -14,82 +16,41 @@ batch, lot, run_unit, simulate_lot_command, JOBS, COMMANDS
 
 from __future__ import annotations
 
-import io
-import sys
-import threading
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
 from align.cli import options as opt
-from align.cli.batchjobs import JOBS, OUTPUT_OPTIONS, RESERVED, _jobs, _task_maker, check_options  # noqa: F401
+from align.cli.batchjobs import (  # noqa: F401
+    JOBS,
+    OUTPUT_OPTIONS,
+    RESERVED,
+    _jobs,
+    _task_maker,
+    check_options,
+    prepare_units,
+)
 
-# ---- the worker: the single command, run in this process with its output captured ----
-
-class _Local(threading.local):
-    out: io.StringIO | None = None
-    err: io.StringIO | None = None
-
-
-_LOCAL = _Local()
-
-
-class _Routed(io.TextIOBase):
-    """A stream that writes to this thread's capture buffer while a unit runs, else to the real stream
-    (a Dask worker runs units in several threads at once)."""
-
-    def __init__(self, real, which: str) -> None:
-        self.real, self.which = real, which
-
-    def _target(self):
-        return getattr(_LOCAL, self.which) or self.real
-
-    def write(self, text: str) -> int:
-        return self._target().write(text)
-
-    def flush(self) -> None:
-        self._target().flush()
-
-    def isatty(self) -> bool:  # no progress bar inside a unit
-        return False if getattr(_LOCAL, self.which) is not None else self.real.isatty()
-
-    @property
-    def encoding(self) -> str:
-        return "utf-8"
+# ---- the worker: the unit's library job ----
 
 
-_ROUTE_LOCK = threading.Lock()
+def _preload(jobs) -> tuple[str, ...]:
+    """The modules a worker needs for ``jobs``: its own and each job's (:data:`align.api.JOBS`)."""
+    from align.api import JOBS as LIBRARY
 
-
-def _capture() -> None:
-    with _ROUTE_LOCK:
-        if not isinstance(sys.stdout, _Routed):
-            sys.stdout = _Routed(sys.stdout, "out")
-        if not isinstance(sys.stderr, _Routed):
-            sys.stderr = _Routed(sys.stderr, "err")
+    return ("align.cli.batch", "align.production.batch",
+            *sorted({LIBRARY[j].partition(":")[0] for j in jobs if j in LIBRARY}))
 
 
 def run_unit(task) -> list[dict]:
-    """Run one unit's single command in this process (:func:`align.cli.run`) and return its table rows.
+    """Run one unit's job in this process (:func:`align.production.run_job`) and return its table rows; a
+    failure is the single command's one line and exit status."""
+    from align.cli.batchjobs import error_line
+    from align.cli.builders import files_builder
+    from align.production import run_job
 
-    The command's stdout is dropped, its stderr (one line on a failure) becomes the unit's message.
-    """
-    import time
-
-    from align.cli import run
-    from align.production import unit_rows
-
-    _capture()
-    digest = task.digest()
-    _LOCAL.out, _LOCAL.err = io.StringIO(), io.StringIO()
-    started = time.perf_counter()
-    try:
-        code = run(list(task.args))
-    finally:
-        err = _LOCAL.err.getvalue()
-        _LOCAL.out = _LOCAL.err = None
-    return unit_rows(task, code, " ".join(err.split()), digest, time.perf_counter() - started)
+    return run_job(task, files_builder(task.unit.job) if task.params else None, error_line)
 
 
 # ---- the commands ----
@@ -141,25 +102,30 @@ def batch(
     lot = read_manifest(manifest, jobs)
     for unit in lot.units:
         check_options(unit, str(manifest))
-    limits = read_spec(spec) if spec is not None else None
-    folder = out if out is not None else lot.folder
-    created = output_folder("out", folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    pool = make_pool(workers or os.cpu_count() or 1, scheduler)
-    started = time.perf_counter()
-    run = BatchRun(total=len({u.serial for u in lot.units}))
+    pool = make_pool(workers or os.cpu_count() or 1, scheduler, _preload({u.job for u in lot.units}))
+    pool.prestart()  # a fork server's workers start (and import the jobs) while the units are prepared here
     try:
-        with locked(folder):
-            tasks, skipped = plan_tasks(lot.units, folder, _task_maker(lot.folder.resolve()), now().isoformat(),
-                                        rerun=rerun)
-            run.add(rejudge_rows(skipped, limits), skipped=True)  # judged again: the spec may be another
-            if tasks:
-                with pool, progress(len(tasks), "units") as tick:
-                    run_units(tasks, run_unit, pool, folder, lambda rows: judge_rows(rows, limits), tick, run)
-    except BaseException:
-        if created and not any(folder.iterdir()):  # nothing ran (no cluster, say): leave no folder behind
-            folder.rmdir()
-        raise
+        prepared = prepare_units(lot.units, lot.folder.resolve(), str(manifest))
+        limits = read_spec(spec) if spec is not None else None
+        folder = out if out is not None else lot.folder
+        created = output_folder("out", folder)
+        folder.mkdir(parents=True, exist_ok=True)
+        started = time.perf_counter()
+        run = BatchRun(total=len({u.serial for u in lot.units}))
+        try:
+            with locked(folder):
+                tasks, skipped = plan_tasks(lot.units, folder, _task_maker(lot.folder.resolve(), prepared),
+                                            now().isoformat(), rerun=rerun)
+                run.add(rejudge_rows(skipped, limits), skipped=True)  # judged again: the spec may be another
+                if tasks:
+                    with pool, progress(len(tasks), "units") as tick:
+                        run_units(tasks, run_unit, pool, folder, lambda rows: judge_rows(rows, limits), tick, run)
+        except BaseException:
+            if created and not any(folder.iterdir()):  # nothing ran (no cluster, say): leave no folder behind
+                folder.rmdir()
+            raise
+    finally:
+        pool.close(cancel=True)  # not used (nothing to run, a refused manifest): stopped, not waited for
     typer.echo(batch_summary(run, str(manifest), pool.where, folder / TABLE, time.perf_counter() - started))
     failed = len(run.lot("failed")) + len(run.lot("error"))
     outside = len(run.lot("ok", "fail"))

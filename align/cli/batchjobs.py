@@ -1,24 +1,33 @@
-"""The jobs a batch may run, and each unit's options checked and made into the single command's words.
+"""The jobs a batch may run, and each unit's manifest row made into its job's options.
 
 A manifest's options are checked against the job's own command when the manifest is read (the click
 command typer builds, :func:`align.cli._click_app`): an unknown option, one the batch gives itself,
-a value missing, or a word that is no option is one :class:`~align.errors.InputError` naming the
-manifest's row. Options naming files are resolved against the manifest's folder, and the input
-files among them enter the unit's content hash: every option typed ``Path`` (found from the
-command's type hints) and the files of ``--axis-down x=FILE,y=FILE,z=FILE``.
+a value missing or malformed, or a word that is no option is one :class:`~align.errors.InputError`
+naming the manifest's row. The row's words (its log, its plan column as the job's plan option, its
+options) are then parsed by that command exactly as the single command parses them
+(``make_context``: typer's parsers, units and domains applied), file values are resolved against
+the manifest's folder, and the job's options builder (:mod:`align.cli.builders`) makes the job's
+frozen options: the worker runs ``align.api.job(name).run(options)``, the single command's job by
+construction. A library error while the options are built (a column list the job refuses, an
+output that would overwrite an input) is the unit's failure, in the single command's words.
+
+The input files of the unit's content hash are the job's own (``job.files(options)``: log, plan, and
+every other input the options name, the ``--axis-down`` captures included).
 
 Public names
 ------------
-JOBS, RESERVED, OUTPUT_OPTIONS, check_options
+JOBS, RESERVED, OUTPUT_OPTIONS, Prepared, check_options, prepare_unit, error_line
 """
 
 from __future__ import annotations
 
 import difflib
+import enum
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Annotated
+from typing import Any
 
-from align.errors import InputError, literal
+from align.errors import AlignError, InputError, literal
 
 #: job -> (the option its manifest ``plan`` column is given as, whether it needs one)
 JOBS: dict[str, tuple[str | None, str]] = {
@@ -38,18 +47,13 @@ FILE_LISTS = ("--axis-down",)
 
 
 def _jobs() -> dict[str, str]:
-    """The jobs this installation has, each with its use of the plan column."""
+    """The jobs this installation has (a command with an options builder, :mod:`align.cli.builders`), each with
+    its use of the plan column."""
     from align.cli import COMMANDS
+    from align.cli.builders import BUILDERS
 
     have = {name if not subs else f"{name} {s}" for name, subs in COMMANDS.items() for s in (subs or (None,))}
-    return {job: use for job, (_, use) in JOBS.items() if job in have}
-
-
-def _command(job: str):
-    from align.cli import alignment, calibrate, noise
-
-    words = job.split()
-    return calibrate.COMMANDS[words[1]] if words[0] == "calibrate" else {**alignment.COMMANDS, **noise.COMMANDS}[words[0]]
+    return {job: use for job, (_, use) in JOBS.items() if job in have and job in BUILDERS}
 
 
 def _click(job: str):
@@ -61,34 +65,22 @@ def _click(job: str):
     return command
 
 
-def _path_options(job: str) -> set[str]:
-    """The options of ``job`` whose value is a file (``--segments``, ``--plot``): resolved against the manifest."""
-    import typing
-
-    found: set[str] = set()
-    for hint in typing.get_type_hints(_command(job), include_extras=True).values():
-        if typing.get_origin(hint) is not Annotated:
-            continue
-        base, *meta = typing.get_args(hint)
-        if Path in (typing.get_args(base) or (base,)):
-            for m in meta:  # typer.Option("--plot", ...) in Annotated: the flag is its first argument, "default"
-                names = [getattr(m, "default", None), *(getattr(m, "param_decls", ()) or ())]
-                found |= {d for d in names if isinstance(d, str) and d.startswith("--")}
-    return found
-
-
 def check_options(unit, where: str) -> None:
-    """Check a unit's options against its job's command: known names, a value where one is needed, no
-    positional words, none of :data:`RESERVED`; ``--axis-down``'s text parsed.
+    """Check a unit's options against its job's command: known names (old spellings too, as the command takes
+    them: :data:`align.cli.options.ALIASES`), a value where one is needed, no positional words, none of
+    :data:`RESERVED`; ``--axis-down``'s text parsed.
 
     Raises
     ------
     InputError
         Naming the manifest ``where``, the unit's row and column options.
     """
+    from align.cli.options import ALIASES
+
     def bad(what: str) -> InputError:
         return InputError(f"{unit.row}, column options: {what}", where)
 
+    aliases = ALIASES.get(unit.job, {})
     params = [p for p in _click(unit.job).params if getattr(p, "param_type_name", "") == "option"]
     flags = {o for p in params if getattr(p, "is_flag", False) for o in (*p.opts, *p.secondary_opts)}
     names = {o for p in params for o in (*p.opts, *p.secondary_opts)}
@@ -97,6 +89,7 @@ def check_options(unit, where: str) -> None:
     while i < len(words):
         word = words[i]
         name, eq, text = word.partition("=")
+        name = aliases.get(name, name)
         if not word.startswith("-") or word == "-":
             raise bad(f"'{literal(word)}' is not an option of {unit.job} (a second log or a stray value?); "
                       "give one log per row, in column log")
@@ -130,47 +123,188 @@ def _axis_down_files(text: str, bad) -> list[tuple[str, str]]:
     return [(a, v) for a, v in parsed.items() if isinstance(v, str)]
 
 
-def _resolved(options: tuple[str, ...], files: set[str], folder: Path) -> tuple[list[str], list[Path]]:
-    """The options with file values made absolute (relative to ``folder``), and the input files among them."""
-    out, inputs, i = [], [], 0
+def _resolved(options: tuple[str, ...], folder: Path) -> list[str]:
+    """The options with the files of ``--axis-down`` made absolute (relative to ``folder``); other path
+    values are resolved once parsed (:func:`_absolute`)."""
+    out, i = [], 0
     while i < len(options):
         word = options[i]
         name, eq, text = word.partition("=")
-        if (name in files or name in FILE_LISTS) and (eq or i + 1 < len(options)):
+        if name in FILE_LISTS and (eq or i + 1 < len(options)):
             value = text if eq else options[i + 1]
-            if name in FILE_LISTS:
-                parts = []
-                for axis, v in _axis_down_files(value, lambda what: InputError(what, "{axis_down}")):
-                    path = (folder / v).resolve()
-                    inputs.append(path)
-                    parts.append(f"{axis}={path}")
-                ranges = [item for item in value.split(",") if item.strip() and ":" in item.partition("=")[2]]
-                resolved = ",".join(parts + [r.strip() for r in ranges])
-            else:
-                path = (folder / value).resolve()
-                resolved = str(path)
-                if name not in OUTPUT_OPTIONS:
-                    inputs.append(path)
+            parts = [f"{axis}={(folder / v).resolve()}"
+                     for axis, v in _axis_down_files(value, lambda what: InputError(what, "{axis_down}"))]
+            ranges = [item for item in value.split(",") if item.strip() and ":" in item.partition("=")[2]]
+            resolved = ",".join(parts + [r.strip() for r in ranges])
             out += [f"{name}={resolved}"] if eq else [name, resolved]
             i += 1 if eq else 2
             continue
         out.append(word)
         i += 1
-    return out, inputs
+    return out
 
 
-def _task_maker(folder: Path):
+@dataclass(frozen=True)
+class Prepared:
+    """A unit's manifest row made into its job's run (what its :class:`~align.production.Task` holds).
+
+    Attributes
+    ----------
+    options : object or None
+        The job's frozen options; None when the job refused them (``refused``).
+    params : dict
+        The command's parameters (plain values: choices as their text, paths absolute) when the row asks
+        for extra output files (``--plot``, ``--c-header``, ``--imucal-json``): the files builder's input;
+        else empty.
+    inputs : tuple of Path or None
+        The files of the content hash: log, plan, then the job's other input files.
+    refused : (int, str) or None
+        The exit status and the single command's one-line error when the options were refused.
+    """
+
+    options: Any
+    params: dict = field(default_factory=dict)
+    inputs: tuple[Path | None, ...] = ()
+    refused: tuple[int, str] | None = None
+
+
+def error_line(job: str, exc: BaseException) -> tuple[int, str]:
+    """The exit status and the one line the single command ``imu-align JOB`` gives for ``exc``
+    (:func:`align.cli.run`: a library error with the inputs spelled as the command's own flags)."""
+    from align.cli import PROG, _internal, _known
+    from align.cli.options import speller
+
+    if isinstance(exc, AlignError):
+        return exc.exit_code, f"{PROG}: error: {' '.join(exc.render(speller(job, _known(job.split()))).split())}"
+    if isinstance(exc, MemoryError):
+        return 1, f"{PROG}: error: out of memory; use a smaller input (or, for allan, a lower --memory-limit-mb)"
+    return 1, f"{PROG}: internal error: {_internal(exc)} (set IMU_ALIGN_DEBUG=1 for details)"
+
+
+def _output_names(job: str) -> set[str]:
+    """The parameters (Python names) of ``job``'s command that name files it writes."""
+    return {p.name for p in _click(job).params if set(getattr(p, "opts", ())) & set(OUTPUT_OPTIONS)}
+
+
+def _absolute(value: Any, folder: Path) -> Any:
+    """A path value resolved against the manifest's ``folder`` (lists of paths too); other values as they are."""
+    if isinstance(value, Path):
+        return (folder / value).resolve()
+    if isinstance(value, (list, tuple)) and value and all(isinstance(v, Path) for v in value):
+        return type(value)((folder / v).resolve() for v in value)
+    return value
+
+
+def _plain(value: Any) -> Any:
+    """A parsed value a worker can unpickle: a choice (an Enum typer makes on the fly) as its text."""
+    return value.value if isinstance(value, enum.Enum) else value
+
+
+def _hashed(unit, files) -> tuple[Path | None, ...]:
+    """The content hash's files: the unit's log and plan, then every other file ``job.files(options)`` names."""
+    first = (unit.log, unit.plan)
+    rest: list[Path] = []
+    for value in files.values():
+        for item in value if isinstance(value, (list, tuple)) else (value,):
+            item = getattr(item, "path", item)  # a LogSource
+            if item is None:
+                continue
+            path = Path(item)
+            if path not in first and path not in rest:
+                rest.append(path)
+    return (*first, *rest)
+
+
+def _parsed(unit, folder: Path, where: str, cache: dict | None) -> dict[str, Any]:
+    """The command's parameters for the unit's row, as click parses them (values not yet resolved).
+
+    Rows of one job with the same options words differ only in their log and plan: those are parsed once
+    (``cache``), the log and plan put in place for each row (a path's value is not checked when parsed).
+    """
+    from align.cli import _usage_message
+    from align.cli.options import rewrite_aliases
+
+    command = _click(unit.job)
+    flag = JOBS[unit.job][0]
+    log_name = next(p.name for p in command.params if getattr(p, "param_type_name", "") == "argument")
+    plan_name = next((p.name for p in command.params if flag in getattr(p, "opts", ())), None) if flag else None
+    key = (unit.job, unit.options, unit.plan is None)
+    if cache is not None and key in cache:
+        params = dict(cache[key])
+    else:
+        words = _resolved(unit.options, folder)  # --axis-down's files made absolute
+        args = [str(unit.log), *([str(flag), str(unit.plan)] if unit.plan is not None else []),
+                *rewrite_aliases(unit.job, words)]
+        try:
+            params = dict(command.make_context(f"imu-align {unit.job}", args, resilient_parsing=False).params)
+        except Exception as exc:
+            if not (hasattr(exc, "exit_code") and hasattr(exc, "format_message")):  # no usage error (click's, typer's)
+                raise
+            what = " ".join(_usage_message(exc, unit.job.split(), args).split())
+            raise InputError(f"{unit.row}, column options: {what}", where) from None
+        if cache is not None:
+            cache[key] = dict(params)
+    params[log_name] = unit.log
+    if plan_name is not None:
+        params[plan_name] = unit.plan
+    return params
+
+
+def prepare_unit(unit, folder: Path, where: str, cache: dict | None = None) -> Prepared:
+    """Parse a unit's row with its job's command and build the job's options (see the module docstring).
+
+    Parameters
+    ----------
+    unit : Unit
+        Its options already checked by :func:`check_options`.
+    folder : Path
+        The manifest's folder (absolute): relative paths in the options are relative to it.
+    where : str
+        The manifest, for messages.
+    cache : dict, optional
+        Rows parsed before (see :func:`prepare_units`).
+
+    Returns
+    -------
+    Prepared
+
+    Raises
+    ------
+    InputError
+        A value the command's parser refuses, naming the manifest, the row and column options.
+    """
+    from align.api import job as find
+    from align.cli.builders import options_builder
+    from align.cli.paths import check_outputs
+
+    params = {name: _absolute(value, folder) for name, value in _parsed(unit, folder, where, cache).items()}
+    outs = _output_names(unit.job)
+    asked = {name: params[name] for name in outs if params.get(name) is not None}
+    try:  # as the single command: its outputs checked, then its options built
+        if asked:
+            check_outputs([v for k, v in params.items() if isinstance(v, Path) and k not in outs], **asked)
+        options = options_builder(unit.job)(**params)
+        files = find(unit.job).files(options)
+    except AlignError as exc:
+        return Prepared(None, {}, (unit.log, unit.plan), error_line(unit.job, exc))
+    return Prepared(options, {k: _plain(v) for k, v in params.items()} if asked else {}, _hashed(unit, files))
+
+
+def prepare_units(units, folder: Path, where: str) -> dict[tuple[str, str], Prepared]:
+    """:func:`prepare_unit` for every unit, by (serial, job); rows with the same options words parsed once."""
+    cache: dict = {}
+    return {(u.serial, u.job): prepare_unit(u, folder, where, cache) for u in units}
+
+
+def _task_maker(folder: Path, prepared: dict | None = None, where: str | None = None):
+    """``make(unit, result, run) -> Task``: the unit's job and options (``prepared``, or made now)."""
     from align.production import Task
 
-    files = {job: _path_options(job) for job in _jobs()}
+    prepared = {} if prepared is None else prepared
 
     def make(unit, result: Path, run: str) -> Task:
-        flag = JOBS[unit.job][0]
-        options, inputs = _resolved(unit.options, files[unit.job], folder)
-        args = [*unit.job.split(), str(unit.log)]
-        if unit.plan is not None:
-            args += [flag, str(unit.plan)]
-        args += [*options, "--json", str(result.resolve())]
-        return Task(unit, tuple(args), result.resolve(), (unit.log, unit.plan, *inputs), run)
+        key = (unit.serial, unit.job)
+        got = prepared[key] if key in prepared else prepare_unit(unit, folder, where or str(folder))
+        return Task(unit, result.resolve(), got.inputs, run, got.options, got.params, got.refused)
 
     return make

@@ -25,6 +25,19 @@ from typing import Any
 
 BUILDERS: dict[str, tuple[str, str | None]] = {
     # each family adds its lines here
+    "allan": ("align.cli.allan:allan_options", "align.cli.allan:allan_files"),
+    "plan": ("align.cli.plan:plan_options", None),
+    "matrix": ("align.cli.matrix:matrix_options", "align.cli.matrix:matrix_files"),
+    "apply": ("align.cli.apply:apply_options", "align.cli.apply:apply_files"),
+    "calibrate ferraris": ("align.cli.calibrate_ferraris:ferraris_options",
+                           "align.cli.calibrate_ferraris:ferraris_files"),
+    "calibrate accel": ("align.cli.calibrate_accel:accel_options", "align.cli.calibrate_accel:accel_files"),
+    "calibrate mag": ("align.cli.calibrate_mag:mag_options", "align.cli.calibrate_mag:mag_files"),
+    "calibrate gyro": ("align.cli.calibrate_gyro:gyro_options", "align.cli.calibrate_gyro:gyro_files"),
+    "budget": ("align.cli.budget:budget_options", "align.cli.budget:budget_files"),
+    "allowable": ("align.cli.allowable:allowable_options", None),
+    "check": ("align.cli.check:check_options", None),
+    "drift": ("align.cli.drift:drift_options", "align.cli.drift:drift_files"),
 }
 
 

@@ -114,6 +114,8 @@ COMMAND_FLAGS: dict[str, dict[str, str]] = {
     "report": {"log": "--log", "mount": "--mount", "manoeuvre": "--manoeuvre"},
     "matrix": {"units": "--gyro-units"},
     "simulate": {"units": "--gyro-units"},
+    "simulate session": {"units": "--gyro-units"},
+    "simulate poses": {"units": "--gyro-units"},
     "calibrate ferraris": {"units": "--accel-units", "columns": "--accel-columns or --gyro-columns"},
     "calibrate accel": {"units": "--accel-units"},
     "calibrate mag": {"units": "--mag-units", "columns": "--columns or --accel-columns"},
@@ -122,7 +124,9 @@ COMMAND_FLAGS: dict[str, dict[str, str]] = {
 
 #: command -> old flag -> its name today; accepted, not shown in --help
 ALIASES: dict[str, dict[str, str]] = {
-    "simulate": {"--fs": "--rate-hz"},
+    "simulate session": {"--fs": "--rate-hz"},
+    "simulate poses": {"--fs": "--rate-hz"},
+    "simulate lot": {"--fs": "--rate-hz"},
     "report": {"--allan-units": "--units", "--allan-columns": "--columns", "--allan-rate-hz": "--rate-hz"},
     "calibrate ferraris": {"--acc-units": "--accel-units", "--gyr-units": "--gyro-units",
                            "--acc-columns": "--accel-columns", "--gyr-columns": "--gyro-columns"},
@@ -139,8 +143,9 @@ def spell(name: str, value: str | None = None, command: str | None = None,
     option for is spelled in words (``min_dwell`` -> ``min dwell``), never as a flag it does not take.
     """
     flag = COMMAND_FLAGS.get(command or "", {}).get(name) or FLAGS.get(name) or "--" + name.replace("_", "-")
-    switch = value is not None and value.lower() in ("true", "false") and flag.startswith("--")
-    if switch and value.lower() == "false":
+    lowered = None if value is None else value.lower()
+    switch = lowered in ("true", "false") and flag.startswith("--")
+    if switch and lowered == "false":
         flag = "--no-" + flag[2:]
     if known is not None and not all(part in known for part in flag.split(" or ")):
         words = name.replace("_", " ")
@@ -257,7 +262,8 @@ def MonteCarlo(help: str = "Monte Carlo draws (0: none)."):
 
 def Choice(flag: str, values: tuple[str, ...], help: str):
     """One of ``values``, checked by the parser; the command receives an Enum member (see :func:`value`)."""
-    kind = enum.Enum(flag.strip("-").title().replace("-", ""), {v: v for v in values}, type=str)
+    # named at run time (one Enum per option): mypy types only functional Enums with a literal name
+    kind = enum.Enum(flag.strip("-").title().replace("-", ""), {v: v for v in values}, type=str)  # type: ignore[misc]
     return Annotated[kind, typer.Option(flag, help=help)]
 
 

@@ -7,12 +7,13 @@ and the commands pass the merged table on.
 
 Public names
 ------------
-parts, parts_table, parts_file, PartsFile, ENV, COMMANDS
+parts, parts_table, parts_file, parts_fields, LazyParts, PartsFile, ENV, COMMANDS
 """
 
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Annotated
 
@@ -57,6 +58,39 @@ def parts_table(option: Path | None):
         if note is None:
             raise
         raise InputError(f"{exc.message} (the parts file {note}; fix it or unset {ENV})", exc.where) from None
+
+
+class LazyParts(Mapping):
+    """The parts table (the presets with the user's parts file laid over them), read on first use: a command
+    reads the parts file only when its mount (or ``--imu``) looks a part up; its errors name the environment
+    variable when the file came from it."""
+
+    def __init__(self, option: Path | None) -> None:
+        self.option: Path | None = option
+        self._table: Mapping | None = None
+
+    def _load(self) -> Mapping:
+        if self._table is None:
+            from align.parts import PARTS
+
+            self._table = parts_table(self.option) or PARTS
+        return self._table
+
+    def __getitem__(self, key):
+        return self._load()[key]
+
+    def __iter__(self):
+        return iter(self._load())
+
+    def __len__(self) -> int:
+        return len(self._load())
+
+
+def parts_fields(option: Path | None) -> dict:
+    """The jobs' ``parts`` and ``parts_table`` fields from ``--parts`` (or the environment variable): the file, for
+    the result's provenance, and its table read on first use (None, None: the presets alone)."""
+    path, _ = parts_file(option)
+    return {"parts": path, "parts_table": None if path is None else LazyParts(option)}
 
 
 def parts(

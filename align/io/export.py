@@ -139,7 +139,7 @@ def _yaml_matrix(m, where: str) -> str:
     return "[" + ", ".join("[" + ", ".join(yaml_float(v, where) for v in row) + "]" for row in np.asarray(m)) + "]"
 
 
-def kalibr_yaml(header: str, scalars: list[tuple[str, object, str]], sensors: dict[str, dict]) -> str:
+def kalibr_yaml(header: str, scalars: list[tuple[str, str | float, str]], sensors: dict[str, dict]) -> str:
     """Kalibr's ``imu.yaml`` (the flat ``ImuParameters`` keys) as text.
 
     Parameters

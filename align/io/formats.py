@@ -114,7 +114,8 @@ class LogFormat:
     def to_dict(self) -> dict:
         """The options as a result's ``inputs`` records them (``delimiter`` as typed words for tab and space)."""
         d = asdict(self)
-        d["delimiter"] = {"\t": "tab", " ": "space"}.get(self.delimiter, self.delimiter)
+        if self.delimiter is not None:
+            d["delimiter"] = {"\t": "tab", " ": "space"}.get(self.delimiter, self.delimiter)
         return d
 
 

@@ -33,13 +33,14 @@ __all__ = ["read_sensor_log", "SensorLog", "read_log", "read_static_log", "Stati
            "sensor_scale", "NpyChunks", "check_finite", "check_readings", "check_time", "check_log", "MAX_READING"]
 
 
-def _check_rate(rate_hz: float | None, path, missing: str = "no time column: give {rate_hz}") -> None:
-    """A sample rate given for a log without time: present, finite and positive."""
+def _check_rate(rate_hz: float | None, path, missing: str = "no time column: give {rate_hz}") -> float:
+    """A sample rate given for a log without time: present, finite and positive (returned)."""
     if rate_hz is None:
         raise InputError(missing, str(path))
     if not (np.isfinite(rate_hz) and rate_hz > 0):
         raise InputError(f"the sample rate must be a finite number of Hz > 0, not {float(rate_hz)!r}; give e.g. "
                          "{rate_hz=100}", str(path))
+    return rate_hz
 
 
 def sensor_scale(units: str, expect: str | None, field: str = "units", counts: bool = False) -> tuple[float, str]:
@@ -185,8 +186,9 @@ def read_sensor_log(
     fmt = log_format or LogFormat()
     field = field or ("gyro_units" if expect == "angular_rate" else "units")
     factor, unit_shown = sensor_scale(units, expect, field, counts)
-    use_time = time_column is not None and rate_hz is None
-    wanted = ([time_column] if use_time else []) + list(columns)
+    time_col = time_column if rate_hz is None else None  # the column read as time (none with a given rate)
+    use_time = time_col is not None
+    wanted = ([time_col] if time_col is not None else []) + list(columns)
     p = Path(path)
     if p.suffix.lower() == ".npy":
         _, data = read_columns(p, log_format=fmt)
@@ -194,17 +196,17 @@ def read_sensor_log(
             raise InputError(f"has {data.shape[1]} columns; expected {len(wanted)} ({', '.join(map(shown, wanted))})"
                              + ("; give {rate_hz} for a file without time" if use_time else ""), str(path))
     else:
-        _, data = read_columns(p, wanted, time_column if use_time else None, fmt)
-    if use_time:
+        _, data = read_columns(p, wanted, time_col, fmt)
+    if time_col is not None:
         raw_t, values = data[:, 0], data[:, 1:]
         check_readings(values, str(path), raw_t)
-        t, tu, detected = _time_of(raw_t, time_column, str(path), fmt)
+        t, tu, detected = _time_of(raw_t, time_col, str(path), fmt)
         step = float(np.median(np.diff(t))) if len(t) > 1 else float("nan")
         fs = 1.0 / step if step > 0 else float("nan")
     else:
-        _check_rate(rate_hz, path)
+        rate = _check_rate(rate_hz, path)
         _rate_only(fmt, path)
-        t, values, tu, detected, fs = np.arange(len(data)) / rate_hz, data, None, False, float(rate_hz)
+        t, values, tu, detected, fs = np.arange(len(data)) / rate, data, None, False, float(rate)
         check_readings(values, str(path), t)
     return SensorLog(np.ascontiguousarray(t), values * factor, units, unit_shown, tu, detected, fs, fmt)
 
@@ -309,29 +311,34 @@ class StaticLog:
         Unit of the time column (None: no time column, ``rate_hz`` given).
     time_detected : bool
         True when ``time_units`` was detected from the sample interval.
+    time_step : float or None
+        The median step of the time column in the file's numbers, when it was read beside a given ``rate_hz``.
     """
 
     data: object
     rate_hz: float
     time_units: str | None
     time_detected: bool
+    time_step: float | None = None
 
 
 def read_static_log(log: str | Path, names: list[str], rate_hz: float | None, log_format: LogFormat | None = None,
-                    scale: float = 1.0) -> StaticLog:
+                    scale: float = 1.0, *, time_column: str = "time", time_step: bool = False) -> StaticLog:
     """Raw columns of a static log and its sample rate, for the Allan deviation.
 
     No unit conversion (the deviations are scaled afterwards, so no SI copy of a
     large record is made) but for ``scale``, the size of one count in the unit the
     deviations are shown in (1 for readings in a unit). ``.npy`` and raw binary files
     come back as a :class:`NpyChunks` source read in chunks; text needs a uniform time
-    column ``time`` (gaps are refused with their position; its unit detected or given by
-    ``log_format``) unless ``rate_hz`` is given.
+    column ``time_column`` (gaps are refused with their position; its unit detected or given by
+    ``log_format``) unless ``rate_hz`` is given. With ``rate_hz`` and ``time_step``, the time column is read
+    too (not checked) and its median step, in the file's numbers, returned as ``time_step`` (a caller compares
+    it with ``rate_hz``).
     """
     log = Path(log)
     fmt = log_format or LogFormat()
     if log.suffix.lower() in (".npy", ".bin", ".f8", ".f4", ".raw"):
-        _check_rate(rate_hz, log, f"a {log.suffix} file has no time: give {{rate_hz}}")
+        rate = _check_rate(rate_hz, log, f"a {log.suffix} file has no time: give {{rate_hz}}")
         if fmt.given():
             raise InputError(f"{', '.join('{' + k + '}' for k in fmt.given())} apply to text logs, not to a "
                              f"{log.suffix} file; leave them out", str(log))
@@ -342,17 +349,24 @@ def read_static_log(log: str | Path, names: list[str], rate_hz: float | None, lo
                              "{columns}", str(log))
         if source.shape[0] == 0:
             raise InputError("holds no samples", str(log))
-        return StaticLog(source, float(rate_hz), None, False)  # its samples are checked as read (align.noise.allan)
+        return StaticLog(source, float(rate), None, False)  # its samples are checked as read (align.noise.allan)
     if rate_hz is not None:
         _check_rate(rate_hz, log)
         _rate_only(fmt, log)
-    wanted = names if rate_hz is not None else ["time"] + names
-    _, data = read_columns(log, wanted, None if rate_hz is not None else "time", fmt)
+    if rate_hz is not None and time_step:
+        _, data = read_columns(log, [time_column] + names, time_column, fmt)
+        head = data[:100_001, 0]
+        step = float(np.median(np.diff(head))) if len(head) > 1 else None
+        data = np.ascontiguousarray(data[:, 1:])
+        check_readings(data, str(log))
+        return StaticLog(data * scale if scale != 1 else data, float(rate_hz), None, False, step)
+    wanted = names if rate_hz is not None else [time_column] + names
+    _, data = read_columns(log, wanted, None if rate_hz is not None else time_column, fmt)
     if rate_hz is not None:
         check_readings(data, str(log))
         return StaticLog(data * scale if scale != 1 else data, float(rate_hz), None, False)
     check_readings(data[:, 1:], str(log), data[:, 0])
-    t, unit, detected = _time_of(data[:, 0], "time", str(log), fmt)
+    t, unit, detected = _time_of(data[:, 0], time_column, str(log), fmt)
     check_log(t, data[:, 1:], str(log), min_rows=3)
     check_time(t, str(log), gap=1.5, jitter=True)  # an Allan deviation needs uniform samples
     values = np.ascontiguousarray(data[:, 1:])

@@ -169,7 +169,7 @@ class Outputs:
         if self._done:
             raise RuntimeError("these outputs are already committed or discarded")
         done: list[tuple[Path, str | None]] = []  # (target, the old file moved aside, or None)
-        current = None
+        current: Path | None = None
         try:
             for target, tmp in self._staged.items():
                 current = target
@@ -183,7 +183,7 @@ class Outputs:
         except BaseException as exc:
             self._undo(done)
             self.discard()
-            if isinstance(exc, OSError):
+            if isinstance(exc, OSError) and current is not None:
                 raise _fail(current, exc) from None
             raise
         for _, backup in done:

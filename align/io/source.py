@@ -206,7 +206,7 @@ class LogSource:
                 from align.io.formats import content_lines
 
                 lines = content_lines(p, self.format, 1)
-                return [c.strip() for c in lines[0][1].split(self.format.separator)] if lines else None
+                return [c.strip().strip('"').strip() for c in lines[0][1].split(self.format.separator)] if lines else None
         except Exception:  # noqa: BLE001 - a header that cannot be read is the reader's to report
             return None
         return None

@@ -182,8 +182,8 @@ def whitespace_columns(p: Path, names: list[str] | None, fmt: LogFormat) -> tupl
     try:
         text = raw.decode("ascii")
     except UnicodeDecodeError as exc:
-        line = raw[: exc.start].count(b"\n") + 1
-        raise InputError(f"line {line}: byte 0x{exc.object[exc.start]:02x} is not part of a number; a blank-separated "
+        lineno = raw[: exc.start].count(b"\n") + 1
+        raise InputError(f"line {lineno}: byte 0x{exc.object[exc.start]:02x} is not part of a number; a blank-separated "
                          "table holds only numbers: clean the file", str(p)) from None
     lines = text.split("\n")
     skipped = min(fmt.skip_rows, len(lines))

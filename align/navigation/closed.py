@@ -31,8 +31,9 @@ gyro bias gives an attitude error linear in time, a velocity error quadratic and
 cubic (the seed's statement after Eq 4: ``dv = g sigma_b t^2 / 2``, ``dp = g sigma_b t^3 / 6``),
 and the random walks grow as ``sqrt(t)``, ``t^1.5``, ``t^2.5``. Flicker noise (bias instability
 ``B``, one-sided PSD ``B^2 / (pi f)``) has no power law of its own: it is the sum of random
-sinusoids at ``f_k = k df`` with variance ``c_k^2 = B^2 df / (pi f_k)`` each (the lines of the
-Monte Carlo's synthesis, :func:`flicker_lines`: from ``1 / (8 T)`` for a mission of ``T``), and
+sinusoids at ``f_k = k df`` with variance ``c_k^2 = B^2 ln(1 + 1/k) / pi`` each, the PSD integrated over
+``[f_k, f_k + df]`` (the lines of the Monte Carlo's synthesis, :func:`flicker_lines`: the model's cutoff
+``1 / (8 T)`` for a mission of ``T``, nothing below it), and
 with ``x = 2 pi f_k t``::
 
     S1^2 = sum c_k^2 (2 sin(x/2))^2 / w^2
@@ -47,7 +48,7 @@ y, z) is an initial attitude error ``eps = C s``: constant angles (S1 = 1), velo
 
 Public names
 ------------
-QUANTITIES, static_sigma, term_sigmas, flicker_lines, dominance, dominance_text, SYNTHESIS_SPAN
+QUANTITIES, static_sigma, term_sigmas, flicker_lines, dominance, dominance_text, SYNTHESIS_SPAN, REFINE
 """
 
 from __future__ import annotations
@@ -61,27 +62,41 @@ QUANTITIES = ("roll", "pitch", "heading", "north velocity", "east velocity", "do
               "north position", "east position", "down position")
 #: flicker is synthesised over this many mission lengths (its lowest frequency is 1 / (SPAN T))
 SYNTHESIS_SPAN = 8
+#: lines per cutoff frequency of the flicker synthesis (its spacing is ``1 / (REFINE SYNTHESIS_SPAN T)``)
+REFINE = 2
 
 
 def flicker_lines(duration: float, points: int, span: int = SYNTHESIS_SPAN) -> tuple[np.ndarray, np.ndarray]:
     """Frequencies (Hz) and variances per unit ``B^2`` of the flicker synthesis of a mission (E4).
 
     The Monte Carlo synthesises flicker on a grid of ``points - 1`` intervals over the mission,
-    ``span`` times as long (:func:`align.flicker.flicker_fft`'s spectrum: one-sided PSD
-    ``B^2 / (pi f)``, lines ``k df``, ``df = 1 / (span T)``) and keeps its first ``T``. The lowest
-    frequency ``1 / (span T)`` is the model's cutoff: flicker slower than that is left out (the
-    variance of a flicker integral grows as ``ln(span)``).
+    ``REFINE span`` times as long (one-sided PSD ``B^2 / (pi f)`` for ``f >= f_c = 1 / (span T)``, zero
+    below), lines ``f_k = k df``, ``df = f_c / REFINE``, ``k >= REFINE``, and keeps its first ``T``. Line
+    ``k`` carries the variance of the band ``[f_k, f_k + df]``::
+
+        c_k^2 = integral_{k df}^{(k+1) df} df' / (pi f') = ln(1 + 1 / k) / pi          (per unit B^2)
+
+    so the lines' variances sum to the model's (``ln(K + 1) / pi`` up to line ``K``) and nothing below
+    the cutoff ``f_c`` enters. (Lines of ``df / (pi f_k)``, the PSD at the line, stand for the bands
+    ``[f_k - df/2, f_k + df/2]``: their sum ``(ln K + 0.577) / pi`` reaches down to about
+    ``f_c / 1.8``, and the drift came out 16-21 % above the stated model at ``t = T``; lines at the
+    bands' lower edges put the variance a little low in frequency, 6 % too much at ``t = T`` with
+    ``df = f_c``, 3 % with ``df = f_c / 2``: :data:`REFINE`.) The cutoff is
+    the model: flicker slower than that is left out (the variance of a flicker integral grows as
+    ``ln(span)``).
 
     Returns
     -------
     f : ndarray, shape (L,)
     c2 : ndarray, shape (L,)
-        ``df / (pi f)``, the Nyquist line halved.
+        ``ln(1 + 1 / k) / pi``, zero below the cutoff (``k < REFINE``), the Nyquist line halved.
     """
-    n = span * (points - 1)
-    df = 1.0 / (span * duration)
-    f = np.arange(1, n // 2 + 1) * df
-    c2 = df / (np.pi * f)
+    n = REFINE * span * (points - 1)
+    df = 1.0 / (REFINE * span * duration)
+    k = np.arange(1, n // 2 + 1)
+    f = k * df
+    c2 = np.log1p(1.0 / k) / np.pi  # the band [f_k, f_k + df] of the PSD: integral B^2 / (pi f) df per unit B^2
+    c2[k < REFINE] = 0.0  # below the cutoff 1 / (span T)
     c2[-1] *= 0.5  # the Nyquist line is real: its cosine only, twice the amplitude (flicker_fft)
     return f, c2
 

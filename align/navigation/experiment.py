@@ -24,7 +24,9 @@ SeedFigures, seed_figures, seed_experiment, Experiment, METHODS, table_rows
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
@@ -114,6 +116,11 @@ def _drift(record: np.ndarray, fs: float, gravity: float) -> np.ndarray:
     return np.column_stack([tr.p[:, 1], tr.p[:, 0], np.unwrap(tr.euler[:, 2])])
 
 
+def _entry(table: Callable[[str], np.ndarray], k: int, method: str) -> float:
+    """Element ``k`` of ``table(method)``: a sort key of :meth:`Experiment.ranking`."""
+    return table(method)[k]
+
+
 @dataclass(frozen=True, eq=False)
 class Experiment(Value):
     """The experiment's numbers and drifts.
@@ -151,7 +158,7 @@ class Experiment(Value):
         rows = []
         for k in range(3):
             for table in (self.mean_abs, self.mean_rel):
-                rows.append(sorted(METHODS, key=lambda m, k=k, f=table: f(m)[k]))
+                rows.append(sorted(METHODS, key=partial(_entry, table, k)))
         return rows
 
 

@@ -202,13 +202,14 @@ def manoeuvre_mission(data: dict, where: str, base_dir, duration: float, fs: flo
     from align.sensitivity import manoeuvre_from_dict
 
     man = manoeuvre_from_dict(data, where, base_dir)
-    settings = dict(heading=heading, latitude=latitude, earth_rate=earth_rate, gravity=gravity)
     if man.segments:
-        return rotation_mission(man.segments, duration, fs, turn_rate, description=man.description, **settings)
+        return rotation_mission(man.segments, duration, fs, turn_rate, heading=heading, latitude=latitude,
+                                earth_rate=earth_rate, gravity=gravity, description=man.description)
     series = data["series"]  # read as the manoeuvre reader read it (its checks passed)
     cols = series.get("columns", "time,wx,wy,wz")
     cols = [c.strip() for c in cols.split(",")] if isinstance(cols, str) else [c.strip() for c in cols]
     path = file_name(series, "file", f"{where}: series.file", "rates.csv", base_dir)
     t, w = read_log(path, cols[1:], series.get("units", "deg/s"), cols[0],
                     log_format=LogFormat(time_units=series.get("time_units", "s")))
-    return rate_mission(t, w, duration, fs, description=man.description, **settings)
+    return rate_mission(t, w, duration, fs, heading=heading, latitude=latitude, earth_rate=earth_rate, gravity=gravity,
+                        description=man.description)

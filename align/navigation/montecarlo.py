@@ -16,9 +16,9 @@ rotation compensation (Savage's ``alpha x nu / 2``) of the turn error within the
 ``dv_k`` holds ``g h``; without it the tilt error would reach the velocity one step late), and the
 slow part ``b(t)`` (turn-on bias, ramp, bias instability, rate random walk) drawn on a grid of
 at most 128 intervals over the mission and linearly interpolated: flicker by spectral synthesis
-over :data:`~align.navigation.closed.SYNTHESIS_SPAN` mission lengths (the lines of
-:func:`~align.navigation.closed.flicker_lines`; PSD ``B^2 / (pi f)`` as
-:func:`align.flicker.flicker_fft`), the random walk ``b_j = b_j-1 + K sqrt(hc) w``. The terms
+of PSD ``B^2 / (pi f)`` above the cutoff ``1 / (SYNTHESIS_SPAN T)`` (the lines of
+:func:`~align.navigation.closed.flicker_lines`, each the variance of its band, on a grid
+``REFINE SYNTHESIS_SPAN`` mission lengths long), the random walk ``b_j = b_j-1 + K sqrt(hc) w``. The terms
 left out of (M1-M3) are second order (an error times the rotation within one step). The mean and
 the standard deviation over the runs are kept at up to ``points`` times (Chan's pairwise update
 over chunks of runs; no run is stored), and the percentiles of :data:`PERCENTILES` of the down
@@ -43,7 +43,7 @@ from numba import njit, prange
 
 from align.attitude import qexp, quat_from_rotvec, quat_multiply
 from align.errors import InputError
-from align.navigation.closed import SYNTHESIS_SPAN, flicker_lines
+from align.navigation.closed import REFINE, SYNTHESIS_SPAN, flicker_lines
 from align.navigation.mission import Mission
 from align.navigation.residuals import ResidualErrors, SensorErrors
 from align.navigation.strapdown import _navigate, earth_rate_ned, euler_from_quat, nav_step, step_increments
@@ -153,7 +153,7 @@ def _runs(dth, dv, h, q0s, g, wie, mg, ma, slow_g, slow_a, hc, white_g, white_a,
 def _flicker(rng: np.random.Generator, runs: int, points: int, hc: float, b: np.ndarray,
              span: int = SYNTHESIS_SPAN) -> np.ndarray:
     """Flicker of PSD ``B^2 / (pi f)`` at ``points`` grid times (runs, points, 3) (closed.flicker_lines)."""
-    n = span * (points - 1)
+    n = REFINE * span * (points - 1)
     f, c2 = flicker_lines((points - 1) * hc, points, span)
     amp = np.sqrt(c2) * n / 2.0  # irfft: a line X_k = A (u + i v) gives (2 A / n) (u cos - v sin)
     amp[-1] = np.sqrt(c2[-1]) * n  # the Nyquist line appears once, real

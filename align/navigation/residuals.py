@@ -57,6 +57,7 @@ SensorErrors, ResidualErrors, residual_errors, mount_rotation, TERM_KEYS, MOUNT_
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
@@ -140,7 +141,7 @@ class SensorErrors(Value):
 
     def only(self, term: str | None) -> SensorErrors:
         """These errors with every term but ``term`` set to zero (None: all zero)."""
-        zero = {k: np.zeros((3, 3) if k == "matrix" else 3) for k in TERM_KEYS if k != term}
+        zero: dict[str, Any] = {k: np.zeros((3, 3) if k == "matrix" else 3) for k in TERM_KEYS if k != term}
         return replace(self, **zero)
 
     def to_dict(self) -> dict:

@@ -11,8 +11,14 @@ gls       generalised least squares of the Allan variance on the model, with pro
 readouts  IEEE point readouts (N at tau = 1 s, floor, K at tau = 3 s) with their intervals
 sim       sensor-error simulator and the seed's three error models
 planner   averaging time and test plan (reference Example 3); result ``imu-align.plan``
-job       the Allan job (logs -> deviation of every run, pooled curve, fits, figures); result ``imu-align.allan``
-jobfile   the JSON form of the job's curves and fits (engineering units, the names of TERM_TABLE)
+analysis  the Allan analysis, the ``allan`` job's result (deviation of every run, pooled curve, fits, figures);
+          result ``imu-align.allan``
+analysisfile the JSON form of the analysis's curves and fits (engineering units, the names of TERM_TABLE)
+job       old name of ``analysis`` (its ``AllanJob`` is ``AllanAnalysis``), kept for one release
+jobfile   old name of ``analysisfile``, kept for one release
+records   static records for the Allan deviation read through the one reader and checked (static, gravity, rate, time unit)
+jobs      the family's jobs for the command line, the report, the batch and scripts: AllanOptions, ALLAN, allan
+          (static records read and checked -> AllanAnalysis), PlanOptions, PLAN, plan (align.api names them)
 
 The plot of an Allan job is :func:`align.present.plots.allan_plot_png` (this
 family draws nothing). Note that ``align.noise.allan`` as an attribute of this
@@ -26,12 +32,12 @@ tau_grid, AllanResult, allan, ArrayChunks, window_stability, edf_overlapping, co
 NoiseFit, fit_noise, point_readouts, noise_figures, nnls_small (fit);
 NoiseSpec, FLICKER_MODELS, simulate_noise, simulate_imu, seed_method_a, seed_method_b, seed_restoring (sim);
 PlanResult, Averaging, noise_target, model_curve, averaging_time, longest_turn, make_plan (planner);
-AllanJob, run_allan, pool_runs, read_runs, plan_from_allan, term_units (job)
+AllanAnalysis (and its old name AllanJob), run_allan, pool_runs, read_runs, plan_from_allan, term_units (analysis)
 """
 
 from align.noise.allan import AllanResult, ArrayChunks, allan, confidence_interval, edf_overlapping, tau_grid, window_stability
+from align.noise.analysis import AllanAnalysis, plan_from_allan, pool_runs, read_runs, run_allan, term_units
 from align.noise.fit import NoiseFit, fit_noise, nnls_small, noise_figures, point_readouts
-from align.noise.job import AllanJob, plan_from_allan, pool_runs, read_runs, run_allan, term_units
 from align.noise.model import (
     FLICKER_FACTOR,
     NOISE_ALPHA,
@@ -45,14 +51,14 @@ from align.noise.model import (
     term,
 )
 from align.noise.planner import (
-                               Averaging,
-                               PlanResult,
-                               averaging_time,
-                               longest_turn,
-                               make_plan,
-                               model_curve,
-                               noise_target,
-                               preset_model,
+    Averaging,
+    PlanResult,
+    averaging_time,
+    longest_turn,
+    make_plan,
+    model_curve,
+    noise_target,
+    preset_model,
 )
 from align.noise.sim import FLICKER_MODELS, NoiseSpec, seed_method_a, seed_method_b, seed_restoring, simulate_imu, simulate_noise
 
@@ -63,5 +69,8 @@ __all__ = [
     "NoiseFit", "fit_noise", "nnls_small", "noise_figures", "point_readouts",
     "FLICKER_MODELS", "NoiseSpec", "seed_method_a", "seed_method_b", "seed_restoring", "simulate_imu", "simulate_noise",
     "Averaging", "PlanResult", "averaging_time", "longest_turn", "make_plan", "model_curve", "noise_target", "preset_model",
-    "AllanJob", "plan_from_allan", "pool_runs", "read_runs", "run_allan", "term_units",
+    "AllanAnalysis", "AllanJob", "plan_from_allan", "pool_runs", "read_runs", "run_allan", "term_units",
 ]
+
+#: the old name of :class:`AllanAnalysis` (the same class), kept for one release
+AllanJob = AllanAnalysis

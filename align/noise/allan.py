@@ -69,6 +69,7 @@ def tau_grid(n: int, fs: float, grid: str | list = "dense", per_decade: int = 10
     m_max = (n - 1) // 2  # at least two second differences behind every point
     if m_max < 1:
         raise InputError(f"only {n} samples: an Allan deviation needs at least 3")
+    m: np.ndarray
     if isinstance(grid, str):
         if grid == "dense":
             k = np.arange(0, int(np.floor(np.log10(m_max) * per_decade)) + 1)
@@ -121,6 +122,7 @@ def _phases(source, fs: float, memory_limit: float, names, progress=None,
     gone once released. Returns the phases, the constants and the column means.
     """
     n, c = source.shape
+    x: np.ndarray
     if c * (n + 1) * 8 > memory_limit:
         fd, path = tempfile.mkstemp(prefix="imu_align_phase_", suffix=".f8")
         os.close(fd)
@@ -149,6 +151,7 @@ def _phases(source, fs: float, memory_limit: float, names, progress=None,
         if progress is not None:
             progress(pos - 1)
     x[:, 1:] *= 1.0 / fs
+    assert const is not None, "a record holds at least one chunk"
     return x, const, const + total / n
 
 

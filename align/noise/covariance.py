@@ -14,8 +14,23 @@ function of order 1), one per term of the IEEE Std 952 model (:mod:`align.noise.
     G(t) = Q^2 [t = 0] - N^2 |t| / 2 + B^2 t^2 ln|t| / (2 pi) + K^2 |t|^3 / 12
 
 (white PM / quantization, white FM, flicker FM, random-walk FM; each reproduces its Allan variance
-term ``3 Q^2/tau^2``, ``N^2/tau``, ``(2 ln 2/pi) B^2``, ``K^2 tau/3``; the deterministic ramp adds no
-variance). ``C(l)`` vanishes for ``l`` outside ``[-2 m1, 2 m2]`` but for flicker, whose tail
+term ``3 Q^2/tau^2``, ``N^2/tau``, ``(2 ln 2/pi) B^2``, ``K^2 tau/3``).
+
+A rate ramp ``R`` adds the same second difference ``mu_m = R tau^2`` to every ``d_m(i)``, so
+``AVAR(m) = R^2 tau^2 / 2 + R ebar_m + sum_i e_m(i)^2 / (2 tau^2 M)`` with ``e`` the noise's second
+differences and ``ebar_m`` their mean; the middle term is linear in the noise (uncorrelated with the
+quadratic one for Gaussian noise) and adds
+
+    cov(AVAR(m1), AVAR(m2)) += R^2 cov(ebar_1, ebar_2) = R^2 sum_l c(l) C(l) / (M1 M2):
+
+under a rate random walk the record's own trend of the rate looks like a ramp, and this is what
+keeps the ramp's uncertainty honest (about ``K / sqrt(T)`` for a record of ``T``). Only the rate random
+walk's part is kept: ``ebar_m`` telescopes to the difference of the rate's means over the record's first and
+last ``2 m`` samples, times ``m^2 tau0 / M``, whose variance is of order ``K^2 T`` for a random walk but
+``N^2 / (m tau0)`` (white) and ``B^2`` (flicker) for stationary rates, smaller by ``(m / M)^2`` or more, and
+sums of nearly cancelling lags that the trapezoid rule would not resolve.
+
+``C(l)`` vanishes for ``l`` outside ``[-2 m1, 2 m2]`` but for flicker, whose tail
 falls as ``1/l^2`` and is cut at eight times the larger ``m``. Lags are summed exactly when at most
 :data:`LAGS` of them matter, otherwise by the trapezoid rule on :data:`LAGS` equally spaced lags
 (the quantization term, a point mass at the nine knots, is always added exactly). As ``C`` is linear
@@ -52,26 +67,30 @@ def _g_terms(t: np.ndarray) -> list[np.ndarray]:
     return [-at / 2, np.where(tiny, 0.0, at * at * np.log(np.where(tiny, 1.0, at))) / (2 * np.pi), at**3 / 12]
 
 
-def avar_covariance_basis(m, n_phase: int, fs: float, lags: int = LAGS) -> np.ndarray:
+def avar_covariance_basis(m, n_phase: float, fs: float, lags: int = LAGS, ramp: bool = False) -> np.ndarray:
     """The covariance of the overlapping Allan variances as a quadratic form in the squared coefficients.
 
-    ``cov = sum_{a,b} p_a p_b S[a, b]`` with ``p = (Q^2, N^2, B^2, K^2)`` (the ramp adds none): computed once,
-    the covariance of any model on the same taus costs one contraction (:func:`combine_covariance`).
+    ``cov = sum_{a,b} p_a p_b S[a, b]`` with ``p = (Q^2, N^2, B^2, K^2)``, or with ``ramp`` ``p = (Q^2, .., K^2, R^2)``
+    and ``S[R, K] = S[K, R] = cov(ebar_1, ebar_2) / (2 K^2)`` (the ramp's cross term with the rate random walk,
+    module docstring; zero elsewhere in the fifth row): computed once, the covariance of any model on the same
+    taus costs one contraction (:func:`combine_covariance`).
 
     Parameters
     ----------
     m : array_like of int, shape (T,)
         Averaging factors, ``1 <= m <= (n_phase - 1) // 2``.
-    n_phase : int
+    n_phase : int or float
         Phase points of the record (samples + 1).
     fs : float
         Sample rate, Hz.
     lags : int
         Lags summed per pair beyond which the sum becomes a trapezoid rule.
+    ramp : bool
+        Also the ramp's cross terms (a fifth row and column).
 
     Returns
     -------
-    ndarray, shape (4, 4, T, T)
+    ndarray, shape (4, 4, T, T), or (5, 5, T, T) with ``ramp``
         ``S[a, b]`` in s^-4 times the phase's generalised covariance units (SI), symmetric in ``(a, b)``.
     """
     m = np.asarray(m, dtype=float)
@@ -97,7 +116,10 @@ def avar_covariance_basis(m, n_phase: int, fs: float, lags: int = LAGS) -> np.nd
     c = np.zeros((3,) + lag.shape)
     for k in range(9):
         c += _COEF[k] * np.array(_g_terms((lag + _P[k] * m1 - _Q[k] * m2) * tau0))
-    s = np.zeros((4, 4, len(ia)))
+    nk = 5 if ramp else 4
+    s = np.zeros((nk, nk, len(ia)))
+    if ramp:  # cov(ebar_1, ebar_2) per unit K^2: sum_l c(l) C_K(l) / (M1 M2), halved (S[R,K] = S[K,R])
+        s[4, 3] = s[3, 4] = np.sum(weight * c[2], axis=1) / (2 * big1[:, 0] * big2[:, 0])
     for a in range(3):
         for b in range(a, 3):
             s[a + 1, b + 1] = s[b + 1, a + 1] = np.sum(weight * c[a] * c[b], axis=1)
@@ -113,26 +135,29 @@ def avar_covariance_basis(m, n_phase: int, fs: float, lags: int = LAGS) -> np.nd
     for a in range(3):
         s[0, a + 1] = s[a + 1, 0] = np.sum(per * cq * co[a], axis=1)
     tau1, tau2 = m1[:, 0] * tau0, m2[:, 0] * tau0
-    s /= 2 * tau1**2 * tau2**2 * big1[:, 0] * big2[:, 0]
-    out = np.zeros((4, 4, t, t))
+    s[:4, :4] /= 2 * tau1**2 * tau2**2 * big1[:, 0] * big2[:, 0]
+    out = np.zeros((nk, nk, t, t))
     out[:, :, ia, ib] = s
     out[:, :, ib, ia] = s
     return out
 
 
 def combine_covariance(basis: np.ndarray, params) -> np.ndarray:
-    """``cov = sum_{a,b} p_a p_b S[a, b]`` for ``params = (Q, N, B, K, R)`` (SI), shape (T, T)."""
-    p = np.square(np.asarray(params, dtype=float)[:4])
+    """``cov = sum_{a,b} p_a p_b S[a, b]`` for ``params = (Q, N, B, K, R)`` (SI), shape (T, T).
+
+    ``basis`` (4, 4, T, T) or (5, 5, T, T) (with the ramp's cross terms) from :func:`avar_covariance_basis`.
+    """
+    p = np.square(np.asarray(params, dtype=float)[: basis.shape[0]])
     return np.einsum("a,b,abij->ij", p, p, basis)
 
 
-def avar_covariance(m, n_phase: int, fs: float, params, lags: int = LAGS) -> np.ndarray:
+def avar_covariance(m, n_phase: float, fs: float, params, lags: int = LAGS) -> np.ndarray:
     """Covariance of the overlapping Allan variances at averaging factors ``m`` under a noise model.
 
     Parameters
     ----------
     m : array_like of int, shape (T,)
-    n_phase : int
+    n_phase : int or float
     fs : float
         As :func:`avar_covariance_basis`.
     params : array_like, shape (5,)
@@ -142,9 +167,10 @@ def avar_covariance(m, n_phase: int, fs: float, params, lags: int = LAGS) -> np.
     Returns
     -------
     ndarray, shape (T, T)
-        ``cov(AVAR_i, AVAR_j)`` in (unit^2)^2, symmetric.
+        ``cov(AVAR_i, AVAR_j)`` in (unit^2)^2, symmetric; with a ramp its cross term with the noise included.
     """
-    return combine_covariance(avar_covariance_basis(m, n_phase, fs, lags), params)
+    ramp = bool(np.asarray(params, dtype=float).reshape(-1)[4:5].sum() != 0)
+    return combine_covariance(avar_covariance_basis(m, n_phase, fs, lags, ramp=ramp), params)
 
 
 def model_edf(m, n_phase: int, fs: float, params, cov: np.ndarray | None = None) -> np.ndarray:

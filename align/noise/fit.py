@@ -11,12 +11,16 @@ their full covariance ``S(p)`` computed analytically from the fitted model itsel
 (:mod:`align.noise.covariance`, exact for Gaussian power-law noise; no bootstrap, no independence
 assumption): non-negative ``p`` minimising ``(y - A p)' S(p)^-1 (y - A p)`` over at most
 :data:`FIT_POINTS` log-spaced points of the curve, ``S`` recomputed from the fit :data:`ITERATIONS`
-times, a term kept only when it lowers the chi-square by 4 or more. The covariance of ``p`` is
+times, then only the terms the data demand (:mod:`align.noise.gls`: a likelihood-ratio test of each term
+against the model refitted without it, chi-bar-square p-values, Holm's step-down procedure over the
+:data:`~align.noise.gls.TRIED` terms tried at the family-wise rate :data:`~align.noise.gls.FALSE_ALARM`; a
+ramp that fails leaves the model, a noise term that fails stays in it unclaimed). The ramp's cross term with
+the rate random walk is in the covariance (:mod:`align.noise.covariance`). The covariance of ``p`` is
 ``(A' S^-1 A)^-1`` on the kept terms, scaled by ``chi2 / dof`` when above 1 (a curve the model does
 not describe), and a parameter's 1-sigma is ``sigma(p_k) / (2 sqrt(p_k))``.
 
-A term is identifiable when it is positive, at least 30 % of the model at some fitted tau, and
-known to 25 % (1-sigma). Otherwise the fit gives its one-sided 95 % upper bound (the largest value
+A term is identifiable when Holm's test claims it, it is at least 30 % of the model at some fitted tau,
+and it is known to 25 % (1-sigma). Otherwise the fit gives its one-sided 95 % upper bound (the largest value
 whose curve alone stays under every point's one-sided 99 % chi-square
 bound ``AVAR edf / chi2_0.01(edf)``, NIST SP 1065 Eq 5.34, about 95 % over the points: at the long-tau end for K and R) and the
 record length (sample rate for ``Q`` and ``N``) at which a term of that size would be identifiable
@@ -38,7 +42,7 @@ import numpy as np
 from align.errors import TestError
 from align.noise.allan import AllanResult, confidence_interval, edf_overlapping, tau_grid
 from align.noise.covariance import avar_covariance, avar_covariance_basis
-from align.noise.gls import GlsFit, nnls_small, scaled_nnls, whitener
+from align.noise.gls import FALSE_ALARM, GlsFit, nnls_small, scaled_nnls, whitener
 from align.noise.model import NOISE_ALPHA, TERMS, NoiseModel, avar_design, model_adev
 from align.noise.readouts import point_readouts
 from align.values import Value
@@ -88,6 +92,11 @@ class NoiseFit(Value):
         For each term that is not identifiable: the record length (s) at which a term as large as ``upper``
         would be identifiable, or for ``Q`` and ``N`` the sample rate (Hz); NaN where none within 65536x.
     method : str
+    pvalues : ndarray, shape (5,)
+        p-value of each term's likelihood-ratio test against the model without it (1 for a term fitted as zero).
+    false_alarm : float
+        The stated chance that a record lacking a term gets it claimed, over all terms tried
+        (:data:`align.noise.gls.FALSE_ALARM`).
     """
 
     params: np.ndarray
@@ -103,6 +112,8 @@ class NoiseFit(Value):
     upper: np.ndarray = field(default_factory=lambda: np.full(5, np.nan))
     needed: np.ndarray = field(default_factory=lambda: np.full(5, np.nan))
     method: str = FIT_METHOD
+    pvalues: np.ndarray = field(default_factory=lambda: np.ones(5))
+    false_alarm: float = FALSE_ALARM
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -162,7 +173,7 @@ def fit_noise(res: AllanResult, channel: int, min_edf: float = 2.0, where: str |
     use = np.flatnonzero((edf >= min_edf) & (avar > 0))
     pick = use[np.unique(np.round(np.linspace(0, len(use) - 1, min(FIT_POINTS, len(use)))).astype(int))]
     a, y = avar_design(tau[pick]), avar[pick]
-    gls = GlsFit(a, y, avar_covariance_basis(res.m[pick], res.n_phase, res.fs) / res.runs,
+    gls = GlsFit(a, y, avar_covariance_basis(res.m[pick], res.n_phase, res.fs, ramp=True) / res.runs,
                  2 * np.maximum(a @ p, y) ** 2 / np.maximum(edf[pick], 1.0))
     p, cov, _ = gls.solve(p, ITERATIONS)
     params = np.sqrt(p)
@@ -171,10 +182,10 @@ def fit_noise(res: AllanResult, channel: int, min_edf: float = 2.0, where: str |
     contrib = a * p[None, :]
     share = (contrib / np.maximum(contrib.sum(axis=1), 1e-300)[:, None]).max(axis=0)
     rel = np.where(p > 0, sigma / np.where(params > 0, params, 1.0), np.inf)
-    ident = (p > 0) & (share >= 0.3) & (rel < 0.25)
+    ident = (p > 0) & gls.claimed[:5] & (share >= 0.3) & (rel < 0.25)
     needed, notes = np.full(5, np.nan), []
     edf_all, dominant = _point_edf(res, channel, p)
-    for k in np.flatnonzero(~ident):
+    for k in np.flatnonzero(~ident).tolist():
         upper[k] = _upper(k, p, tau[use], avar[use], edf_all[use])
         needed[k], here = _needed(k, upper[k], p, res)
         notes.append(_note(k, p[k], share[k], rel[k], needed[k], res, here))
@@ -182,7 +193,7 @@ def fit_noise(res: AllanResult, channel: int, min_edf: float = 2.0, where: str |
     readouts = point_readouts(tau, adev, edf_all, lambda idx: avar_covariance(res.m[idx], res.n_phase, res.fs, params) / res.runs,
                               params)
     return NoiseFit(params, sigma, tuple(bool(i) for i in ident), tuple(notes), dominant, edf_all, lo, hi, readouts,
-                    cov, upper, needed)
+                    cov, upper, needed, pvalues=gls.pvalues[:5].copy())
 
 
 def _upper(k: int, p: np.ndarray, tau: np.ndarray, avar: np.ndarray, edf: np.ndarray) -> float:
@@ -209,7 +220,8 @@ def _identifiable_at(k: int, p: np.ndarray, n: float, fs: float, runs: int = 1) 
     s = avar_covariance(m, n + 1, fs, np.sqrt(p), lags=32) / runs
     wh = whitener(s, np.diag(s) + 1e-300)
     aw = wh @ a[:, cols]
-    var = np.linalg.pinv(aw.T @ aw)[list(cols).index(k), list(cols).index(k)]
+    at = cols.tolist().index(k)
+    var = np.linalg.pinv(aw.T @ aw)[at, at]
     contrib = a * p[None, :]
     share = float(np.max(contrib[:, k] / np.maximum(contrib.sum(axis=1), 1e-300)))
     return bool(share >= 0.3 and np.sqrt(max(var, 0.0)) / (2 * p[k]) < 0.25)
@@ -280,13 +292,14 @@ def noise_figures(y: np.ndarray, fs: float, periods=(1.0, 10.0)) -> dict:
     of consecutive windows of ``P`` seconds (Eq 7). Units as ``y``.
     """
     y = np.asarray(y, dtype=float)
-    out = {"bias": float(np.mean(y)), "stability": {}}
+    stability: dict[float, float] = {}
+    out = {"bias": float(np.mean(y)), "stability": stability}
     for p in periods:
         k = int(round(p * fs))
         windows = len(y) // k if k > 0 else 0
         if windows < 2:
-            out["stability"][p] = float("nan")
+            stability[p] = float("nan")
             continue
         means = y[: windows * k].reshape(windows, k).mean(axis=1)
-        out["stability"][p] = float(np.std(means, ddof=1))
+        stability[p] = float(np.std(means, ddof=1))
     return out

@@ -4,8 +4,22 @@ The model ``y = A p`` (``y`` the overlapping Allan variances at T taus, ``A`` th
 :func:`align.noise.model.avar_design`, ``p`` the squared coefficients ``Q^2 .. R^2``) is fitted by
 minimising ``chi2(p) = (y - A p)' S(p)^-1 (y - A p)`` over ``p >= 0``, with ``S(p)`` the covariance of
 the estimates under the model itself (:mod:`align.noise.covariance`, a quadratic form in ``p``),
-iterated from a start. A term stays only when dropping it raises ``chi2`` by at least
-:data:`PRUNE_CHI2` (a likelihood-ratio test at about 2 sigma). A curve the model does not describe
+iterated from a start. A term stays only when the data demand it (:meth:`GlsFit.solve`): a likelihood-ratio
+test of each term against the model without it,
+
+    D_k = chi2_0(p_0) - min_{p >= 0} chi2_0(p),
+
+both with the covariance ``S(p_0)`` of the model refitted without the term (the null hypothesis's own
+covariance: the fitted term cannot lower the weights it is tested with). A term on the boundary of its
+domain (``p_k >= 0``) has the chi-bar-square null distribution ``D ~ 1/2 chi2_0 + 1/2 chi2_1`` (Self & Liang
+1987), p-value ``P_k = erfc(sqrt(D_k / 2)) / 2``. The look-elsewhere effect of trying :data:`TRIED` terms is
+held by Holm's step-down procedure (Holm 1979): sorted p-values ``P_(1) <= P_(2) <= ...`` are significant while
+``P_(i) <= FALSE_ALARM / (TRIED - i + 1)``. A deterministic signal (the ramp, a periodic part) that is not
+significant is dropped, the least significant first, the model refitted and the tests repeated; a noise term
+that is not significant stays in the model, unclaimed (its variance belongs in the covariance every other term
+is weighed with: a rate random walk's own trend looks like a ramp, and the ramp must prove itself against the
+whole noise model, not the noise model against the ramp). The chance that a record without a term
+still gets it is then at most :data:`FALSE_ALARM` over all the terms tried. A curve the model does not describe
 (``chi2`` above its 99 % quantile; real sensors: a slope between the ideal ones, a bump) would make
 GLS chase the differences between nearly equal, strongly correlated points; such a fit adds an
 independent relative error ``e`` to every point, ``S + diag((e A p)^2)``, with ``e`` set so that
@@ -16,7 +30,7 @@ The covariance of the kept coefficients is ``(A' S^-1 A)^-1`` at the estimate, s
 
 Public names
 ------------
-nnls_small, GlsFit, PRUNE_CHI2
+nnls_small, GlsFit, PRUNE_CHI2, FALSE_ALARM, TRIED, term_pvalue, holm
 """
 
 from __future__ import annotations
@@ -25,10 +39,38 @@ import numpy as np
 
 from align.noise.covariance import combine_covariance
 
-__all__ = ["nnls_small", "GlsFit", "PRUNE_CHI2"]
+__all__ = ["nnls_small", "GlsFit", "PRUNE_CHI2", "FALSE_ALARM", "TRIED", "term_pvalue", "holm"]
 
-#: least drop of chi-square for which a term stays in the fit (2 sigma)
-PRUNE_CHI2 = 4.0
+#: the stated false-alarm rate: the chance that a record lacking a term gets it claimed, over all terms tried
+FALSE_ALARM = 0.01
+#: the terms tried (the five IEEE terms and a periodic component): Holm's family
+TRIED = 6
+#: columns from this index on are deterministic signals (ramp, periodic), dropped before any noise term
+DETERMINISTIC = 4
+#: least drop of chi-square for which a single term alone would pass Holm's first step (chi-bar-square at
+#: FALSE_ALARM / TRIED; kept for callers of the former fixed threshold)
+PRUNE_CHI2 = 8.6154  # 2 erfcinv(2 FALSE_ALARM / TRIED)^2
+
+
+def term_pvalue(delta: float) -> float:
+    """p-value of a likelihood-ratio drop ``delta`` of one non-negative term: ``P(1/2 chi2_0 + 1/2 chi2_1 > delta)``."""
+    from scipy.special import erfc
+
+    return 1.0 if not delta > 0 else float(0.5 * erfc(np.sqrt(delta / 2)))
+
+
+def holm(pvalues: np.ndarray, alpha: float = FALSE_ALARM, tried: int = TRIED) -> np.ndarray:
+    """Holm's step-down test: which of ``pvalues`` (K,) are significant at family-wise rate ``alpha`` over ``tried``.
+
+    Sorted ascending, ``P_(i)`` is significant while every ``P_(j) <= alpha / (tried - j + 1)``, ``j <= i``.
+    """
+    pvalues = np.asarray(pvalues, dtype=float)
+    out = np.zeros(len(pvalues), dtype=bool)
+    for i, k in enumerate(np.argsort(pvalues, kind="stable")):
+        if not pvalues[k] <= alpha / (tried - i):
+            break
+        out[k] = True
+    return out
 
 
 def nnls_small(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -73,18 +115,28 @@ def whitener(cov: np.ndarray, fallback: np.ndarray) -> np.ndarray:
 
 
 class GlsFit:
-    """One channel's GLS problem on fixed taus: ``A`` (T, 5), ``y`` (T,), covariance basis (4, 4, T, T).
+    """One channel's GLS problem on fixed taus: ``A`` (T, J), ``y`` (T,), covariance basis (4 or 5, 4 or 5, T, T).
 
-    ``fallback`` (T,) are variances used where the model covariance is singular (a zero model).
+    The first five columns of ``A`` are the IEEE terms (:func:`align.noise.model.avar_design`); further columns
+    (a periodic component) add no covariance. ``fallback`` (T,) are variances used where the model covariance is
+    singular (a zero model). ``scan`` (J,) is the number of shapes a column was chosen from (the periodic
+    component's periods: its p-value is multiplied by it, Bonferroni); 1 for the terms.
     """
 
-    def __init__(self, a: np.ndarray, y: np.ndarray, basis: np.ndarray, fallback: np.ndarray) -> None:
+    def __init__(self, a: np.ndarray, y: np.ndarray, basis: np.ndarray, fallback: np.ndarray,
+                 scan: np.ndarray | None = None) -> None:
         self.a, self.y, self.basis, self.fallback = a, y, basis, fallback
         self.excess = 0.0
+        self.scan = np.ones(a.shape[1]) if scan is None else np.asarray(scan, dtype=float)
+        #: p-value of each column's likelihood-ratio test in the final model (1 where fitted as zero)
+        self.pvalues = np.ones(a.shape[1])
+        #: the columns Holm's test finds significant in the final model
+        self.claimed = np.zeros(a.shape[1], dtype=bool)
 
     def wh(self, p: np.ndarray) -> np.ndarray:
-        """Whitening matrix of the covariance under squared coefficients ``p`` (5,), with the model's excess error."""
-        cov = combine_covariance(self.basis, np.sqrt(np.maximum(p, 0.0)))
+        """Whitening matrix of the covariance under squared coefficients ``p`` (J,), with the model's excess error."""
+        q = np.sqrt(np.maximum(p[: self.basis.shape[0]], 0.0))
+        cov = combine_covariance(self.basis, np.pad(q, (0, max(0, 5 - len(q)))))
         if self.excess > 0:
             cov = cov + np.diag((self.excess * (self.a @ p)) ** 2)
         return whitener(cov, self.fallback)
@@ -93,40 +145,68 @@ class GlsFit:
         r = wh @ (self.a @ p - self.y)
         return float(r @ r)
 
-    def _nnls(self, wh: np.ndarray, allowed: np.ndarray, test: bool) -> np.ndarray:
+    def _nnls(self, wh: np.ndarray, allowed: np.ndarray) -> tuple[np.ndarray, float]:
+        """NNLS on the ``allowed`` columns with whitening ``wh``: the squared coefficients (J,) and their chi2."""
         aw, yw = wh @ self.a, wh @ self.y
+        out = np.zeros(self.a.shape[1])
+        c = np.flatnonzero(allowed)
+        if len(c):
+            out[c] = scaled_nnls(aw[:, c], yw)
+        r = aw @ out - yw
+        return out, float(r @ r)
 
-        def fit(c: np.ndarray) -> tuple[np.ndarray, float]:
-            out = np.zeros(5)
-            if len(c):
-                out[c] = scaled_nnls(aw[:, c], yw)
-            r = aw @ out - yw
-            return out, float(r @ r)
+    def _iterate(self, p: np.ndarray, iterations: int, allowed: np.ndarray | None = None) -> np.ndarray:
+        """Iterated GLS from ``p``: each pass weighs with the covariance of the previous fit."""
+        allowed = np.ones(len(p), dtype=bool) if allowed is None else allowed
+        for _ in range(iterations + 1):
+            p, _ = self._nnls(self.wh(p), allowed)
+        return p
 
-        p, chi2 = fit(np.flatnonzero(allowed))
-        while test:
+    def test_terms(self, p: np.ndarray, inplay: np.ndarray, iterations: int = 2) -> np.ndarray:
+        """p-value (J,) of each positive column of ``p`` against the model refitted without it (module docstring).
+
+        The model without column ``k`` may use every other column ``inplay`` (J,) (a term fitted as zero beside
+        ``k`` may take its place); 1 for columns fitted as zero.
+        """
+        out = np.ones(len(p))
+        for k in np.flatnonzero(p > 0):
+            without = inplay.copy()
+            without[k] = False
+            q = self._iterate(np.where(without, p, 0.0), iterations, without)
+            wh = self.wh(q)
+            _, best = self._nnls(wh, inplay)
+            delta = self.chi2(q, wh) - best
+            out[k] = min(1.0, term_pvalue(delta) * self.scan[k])
+        return out
+
+    def select(self, p: np.ndarray, iterations: int) -> np.ndarray:
+        """Holm's backward selection (module docstring) from the fit ``p``; the squared coefficients kept (J,).
+
+        A deterministic signal (column ``>= DETERMINISTIC``) that is not significant leaves the model; a noise term
+        that is not stays in it (its variance belongs in the covariance every other term is judged and weighed
+        with) but is not claimed. :attr:`claimed` (J,) marks the columns Holm's test finds significant.
+        """
+        inplay = np.ones(len(p), dtype=bool)
+        while True:
+            pv = self.test_terms(p, inplay)
             active = np.flatnonzero(p > 0)
-            if len(active) < 2:
-                break
-            trials = [fit(np.setdiff1d(active, [k])) for k in active]
-            best = int(np.argmin([t[1] for t in trials]))
-            if trials[best][1] - chi2 >= PRUNE_CHI2:
-                break
-            p, chi2 = trials[best]
-        return p
-
-    def _iterate(self, p: np.ndarray, iterations: int, test: bool = True) -> np.ndarray:
-        allowed = np.ones(5, dtype=bool)
-        for it in range(iterations + 1):
-            p = self._nnls(self.wh(p), allowed, test=test and it == iterations - 1)
-            allowed = p > 0
-        return p
+            ok = holm(pv[active])
+            self.pvalues = pv
+            self.claimed = np.zeros(len(p), dtype=bool)
+            self.claimed[active[ok]] = True
+            weak = active[~ok]
+            signal = weak[weak >= DETERMINISTIC]
+            if not len(signal):
+                return p
+            inplay[signal[np.argmax(pv[signal])]] = False
+            p = self._iterate(np.where(inplay, p, 0.0), iterations, inplay)
 
     def solve(self, p0: np.ndarray, iterations: int = 4) -> tuple[np.ndarray, np.ndarray, float]:
-        """Iterated GLS from ``p0``; the test of terms after ``iterations`` passes, then a refit of what stays.
+        """Iterated GLS from ``p0``, the terms the data demand (Holm's selection), then the covariance of what stays.
 
-        Returns the squared coefficients (5,), their covariance (5, 5) (NaN for terms fitted as zero;
-        ``(A' S^-1 A)^-1`` on the others) and ``chi2 / dof`` (1 when no degree of freedom is left).
+        Returns the squared coefficients (J,), their covariance (J, J) (NaN for terms fitted as zero;
+        ``(A' S^-1 A)^-1`` on the others) and ``chi2 / dof`` (1 when no degree of freedom is left). The p-values of
+        the final model's terms are in :attr:`pvalues`.
         """
         from scipy.special import gammaincinv
 
@@ -138,13 +218,14 @@ class GlsFit:
             lo, hi = -6.0, 0.0
             for _ in range(14):
                 self.excess = 10 ** ((lo + hi) / 2)
-                q = self._iterate(p, 2, test=False)
+                q = self._iterate(p, 2)
                 lo, hi = (lo, (lo + hi) / 2) if self.chi2(q, self.wh(q)) < dof else ((lo + hi) / 2, hi)
             self.excess = 10**hi
             p = self._iterate(p, iterations)
+        p = self.select(p, iterations)
         wh = self.wh(p)
         active = np.flatnonzero(p > 0)
-        cov = np.full((5, 5), np.nan)
+        cov = np.full((len(p), len(p)), np.nan)
         if len(active):
             aw = wh @ self.a[:, active]
             cov[np.ix_(active, active)] = np.linalg.pinv(aw.T @ aw)

@@ -130,8 +130,8 @@ def averaging_time(target: float, tau: np.ndarray | None = None, adev: np.ndarra
     lt, la = np.log(tau[branch]), np.log(adev[branch])
     k = int(np.argmax(la <= np.log(target)))
     frac = (np.log(target) - la[k - 1]) / (la[k] - la[k - 1])
-    tau = float(np.exp(lt[k - 1] + frac * (lt[k] - lt[k - 1])))
-    return Averaging(tau, floor, t_floor, "measured curve (log-log interpolation)")
+    t_met = float(np.exp(lt[k - 1] + frac * (lt[k] - lt[k - 1])))
+    return Averaging(t_met, floor, t_floor, "measured curve (log-log interpolation)")
 
 
 def _infeasible(target: float, floor: float) -> str:

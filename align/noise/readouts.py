@@ -137,6 +137,7 @@ def point_readouts(tau: np.ndarray, adev: np.ndarray, edf: np.ndarray | None = N
             out[key + "_lo"], out[key + "_hi"] = _interval(c, v)
     ok = edf >= FLOOR_EDF if edf is not None else np.ones(len(tau), dtype=bool)
     if not ok.any():
+        assert edf is not None  # without an EDF every point is kept
         ok = edf >= np.max(edf)
     i0 = int(np.flatnonzero(ok)[np.argmin(adev[ok])])
     lo_i = hi_i = i0

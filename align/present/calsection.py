@@ -109,7 +109,7 @@ def magnetometer_section(cal, source: str, picture: bytes | None = None, picture
     soft = [[f"row {a}"] + [f"{cal.soft_iron[i, j]:+.6f}" for j in range(3)] for i, a in enumerate(_AXES)]
     assumed = any(n.startswith("dip not measured") for n in cal.notes)
     dip = "not known" if cal.dip is None else f"{cal.dip / DEG:.2f} deg" + (" (assumed, not measured)" if assumed else "")
-    rows = [["model", cal.model], ["field after calibration", f"{_values([cal.field], u, '.6g')[0]} {u}"],
+    rows = [["model", cal.model], ["field after calibration", f"{_values(np.array([cal.field]), u, '.6g')[0]} {u}"],
             ["field spread before (std |m| / mean |m|)", f"{100 * cal.spread_before:.2f} %"],
             ["field spread after", f"{100 * cal.spread_after:.2f} %"],
             ["coverage (1/3 for a full sphere)", f"{cal.coverage:.3f}"],

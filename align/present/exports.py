@@ -162,7 +162,8 @@ def _matrix_csv(r: Result, where: str) -> str:
             rows += (_matrix_rows("M", s, c.M, c.sigma_M, mu) + _matrix_rows("A", s, inv, None, "1" if mu == "1" else f"1/({mu})")
                      + _vector_rows("bias", s, to_unit(c.bias, c.units), to_unit(c.sigma_bias, c.units), c.units)
                      + _angle_rows(s, c.M, c.sigma_M, unit=mu))
-    else:  # MagCalibration
+    else:
+        assert isinstance(r, MagCalibration), r.FORMAT  # EXPORTS["csv"]: the only other matrix result
         a = r.correcting
         m = _inverse(a, f"{where}: soft_iron")
         rows = (_matrix_rows("M", "magnetometer", m, None, "1") + _matrix_rows("A", "magnetometer", a, None, "1")
@@ -185,7 +186,7 @@ def _matrix_csv(r: Result, where: str) -> str:
 def _allan_csv(job: AllanJob, where: str) -> str:
     r, u = job.result, job.units
     cols = ["tau [s]"]
-    data = [r.tau]
+    data: list[np.ndarray] = [r.tau]
     for j, n in enumerate(r.names):
         f = job.fits[j]
         cols += [f"{n} adev [{u}]", f"{n} ci_low [{u}]", f"{n} ci_high [{u}]"]
@@ -243,6 +244,7 @@ def _kalibr_intrinsics(r: Result, where: str) -> tuple[dict, str]:
         low, rot = lower_rotation(r.M, f"{where}: M")
         return ({"gyroscopes": {"M": low, "A": np.zeros((3, 3)), "C_gyro_i": rot}},
                 f"IMU frame i = {_ALIGN_FRAME}; gyroscopes.A (g-sensitivity) not estimated: zero")
+    assert isinstance(r, CalibrationSet), r.FORMAT  # EXPORTS["kalibr"]: the only other result with intrinsics
     _physical(r, "Kalibr's M", where)
     out, rot_a, note = {}, np.eye(3), f"IMU frame i = {_CAL_FRAME}"
     if "accelerometer" in r.sensors:
@@ -275,7 +277,7 @@ def _kalibr(results: list[tuple[Result, str]], rostopic: str) -> str:
             intrinsics = (r, where)
         else:
             raise _refuse(r, "kalibr", where)
-    scalars: list[tuple[str, object, str]] = [("rostopic", rostopic, "")]
+    scalars: list[tuple[str, str | float, str]] = [("rostopic", rostopic, "")]
     rates = {float(j.result.fs) for j, _ in noise.values()}
     if len(rates) > 1:
         raise InputError(f"the Allan results were sampled at different rates ({', '.join(f'{x:g}' for x in sorted(rates))}"
@@ -357,9 +359,11 @@ def export_text(results: list[tuple[Result, str]], to: str, name: str | None = N
             return r.as_c_header(f"imu-align alignment {_source(r, where)}", name or "IMU_ALIGN")
         if isinstance(r, CalibrationSet):
             return _calibration_header(r, name or "IMU_CAL", where)
+        assert isinstance(r, MagCalibration), r.FORMAT  # EXPORTS["c"]
         return _mag_header(r, name or "IMU_MAG", where)
     if to == "csv":
         return _allan_csv(r, where) if isinstance(r, AllanJob) else _matrix_csv(r, where)
+    assert isinstance(r, CalibrationSet), r.FORMAT  # EXPORTS["imucal"]
     missing = [s for s in ("accelerometer", "gyroscope") if s not in r.sensors]
     if missing:
         raise InputError(f"imucal's format needs an accelerometer and a gyroscope; this calibration has no "

@@ -13,14 +13,13 @@ Report, mount_job, manoeuvre_job, alignment_job, allan_job, calibration_job, dri
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from align.errors import AlignError
-from align.io import LogFormat, read_sensor_log, read_static, read_toml
+from align.io import LogFormat
 from align.present.html import Section
 from align.present.presets import preset_lines
 from align.present.reread import LOG_FIELDS, Said, in_words, read_capture, statics_picture, template
@@ -72,19 +71,33 @@ def _deg(x: float) -> str:
     return f"{x / DEG:.4f} deg"
 
 
-def mount_job(rep: Report, mount: Path, monte_carlo: int, seed: int, progress=None, parts: dict | None = None):
-    """The mounting budget (Eq 1-4, worst case, Monte Carlo); returns the Budget and the mount.
+def _stamp_shown(rep: Report, job, result, options):
+    """``job.stamp(result, options)`` (options naming the files as shown), each input file hashed where it is read
+    (``rep.source``: the demo's staged copies)."""
+    import dataclasses
+
+    from align.provenance import file_record
+
+    r = job.stamp(result, options)
+    if rep.source is Path or r.provenance is None:
+        return r
+    files = tuple(dataclasses.replace(file_record(f.role, rep.source(Path(f.path))), path=f.path)
+                  for f in r.provenance.files)
+    return r.replace(provenance=dataclasses.replace(r.provenance, files=files))
+
+
+def mount_job(rep: Report, mount: Path, monte_carlo: int, seed: int, progress=None, parts: Mapping | None = None):
+    """The mounting budget (Eq 1-4, worst case, Monte Carlo): the ``budget`` job (:data:`mechanics.jobs.BUDGET`)
+    run with the options the command builds; returns the Budget and the mount.
 
     ``parts`` is the table of presets the mount's part is looked up in (the built-in one when None).
     """
-    from mechanics.budget import budget
-    from mechanics.montecarlo import monte_carlo as run_mc
-    from mechanics.mount import mount_from_dict
+    from mechanics.jobs import BUDGET, BudgetOptions
+    from mechanics.jobs import read as read_budget
 
-    m = mount_from_dict(read_toml(rep.source(mount)), str(mount), Path(mount).parent, parts=parts)
-    b = budget(m)
-    if monte_carlo:
-        b = b.replace(monte_carlo=run_mc(m, monte_carlo, seed, progress=progress))
+    opts = BudgetOptions(mount=Path(mount), monte_carlo=monte_carlo, seed=seed, parts_table=parts)
+    b = _stamp_shown(rep, BUDGET, BUDGET.compute(read_budget(opts, rep.source), opts, progress), opts)
+    m = b.mount
     rep.inputs["mount"] = (str(mount), rep.text(mount))
     rep.results["budget"] = b
     rep.lines.append(f"budget: source total {b.total / DEG:.4f} deg, worst case {b.worst_case / DEG:.4f} deg"
@@ -94,21 +107,29 @@ def mount_job(rep: Report, mount: Path, monte_carlo: int, seed: int, progress=No
     return b, m
 
 
-def manoeuvre_job(rep: Report, manoeuvre: Path, budget=None, mount=None, basis: str = "rss", monte_carlo: int = 0):
-    """What the manoeuvre allows and, with a budget, the budget against it; the budget's section too."""
+def manoeuvre_job(rep: Report, manoeuvre: Path | None, budget=None, mount=None, basis: str = "rss", monte_carlo: int = 0,
+                  mount_path: Path | None = None):
+    """What the manoeuvre allows and, with a budget, the budget against it; the budget's section too.
+
+    The ``allowable`` and ``check`` jobs (:mod:`align.sensitivity.jobs`) with the options the commands build; the
+    check's table from the budget already computed (``mount_path``: its file, named in the table).
+    """
     import align.present.html as report
+    from align.sensitivity.margins import Margin
     from mechanics.render import assembly_png, histogram_png
 
     allow = table = None
     if manoeuvre is not None:
-        from align.sensitivity import allowable, check_margins, manoeuvre_from_dict
+        from align.sensitivity.jobs import ALLOWABLE, CHECK, AllowableOptions, CheckOptions, check_table, read_allowable
 
-        man = manoeuvre_from_dict(read_toml(rep.source(manoeuvre)), str(manoeuvre), Path(manoeuvre).parent)
+        aopts = AllowableOptions(manoeuvre=Path(manoeuvre))
+        allow = _stamp_shown(rep, ALLOWABLE, ALLOWABLE.compute(read_allowable(aopts, rep.source), aopts, None), aopts)
         rep.inputs["manoeuvre"] = (str(manoeuvre), rep.text(manoeuvre))
-        allow = allowable(man)
         rep.results["allowable"] = allow
         if budget is not None:
-            table = check_margins(budget.elements(basis), allow, basis)
+            shown = mount_path if mount_path is not None else rep.inputs.get("mount", ("mount",))[0]
+            copts = CheckOptions(mount=Path(shown), manoeuvre=Path(manoeuvre), basis=basis)
+            table = _stamp_shown(rep, CHECK, check_table(budget, allow, copts), copts)
             rep.results["check"] = table
         rep.lines.append(f"allowance: binding {allow.binding} = {allow.binding_value / DEG:.4f} deg"
                          + ("" if table is None else
@@ -117,7 +138,7 @@ def manoeuvre_job(rep: Report, manoeuvre: Path, budget=None, mount=None, basis: 
         rep.add("mount", report.budget_section(budget, histogram_png(budget) if monte_carlo else None,
                                                assembly_png(mount)))
         if table is not None:
-            w = worst(list(table.rows))
+            w: Margin = worst(list(table.rows))  # type: ignore[assignment]  # the check's binding row
             rep.verdicts.append(Verdict(
                 f"mounting budget ({basis}) vs allowance", PASS if table.passed else FAIL,
                 f"{w.element} margin {w.margin / DEG:+.4f} deg", w.margin / DEG,
@@ -131,34 +152,41 @@ def manoeuvre_job(rep: Report, manoeuvre: Path, budget=None, mount=None, basis: 
     return allow
 
 
-def _log_columns(columns: str | None, rate_hz: float | None) -> tuple[str | None, list[str]]:
-    """The report's rate-table log columns: ``time,x,y,z``, or ``x,y,z`` with a sample rate."""
-    from align.errors import InputError
+def _log_source(rep: Report, log: Path, gyro_units: str, log_format: LogFormat | None, columns: str | None,
+                 rate_hz: float | None, time_column: str | None = None):
+    """The rate-table log as the report's options give it, as ``matrix`` takes it (:class:`~align.io.source.LogSource`:
+    ``x,y,z`` with the time column ``time_column`` or ``time``, or ``time,x,y,z``; ``x,y,z`` with a sample rate)."""
+    from align.io.source import LogSource
 
-    names = [c.strip() for c in (columns or "time,gyro_x,gyro_y,gyro_z").split(",") if c.strip()]
-    if len(names) != (3 if rate_hz is not None else 4):
-        raise InputError("give four names time,x,y,z (three, x,y,z, with {log_rate_hz})", "{gyro_columns}")
-    return (None, names) if rate_hz is not None else (names[0], names[1:])
+    names = None if columns is None else tuple(c.strip() for c in columns.split(",") if c.strip())
+    return LogSource(path=Path(rep.source(log)), columns=names, time_column=time_column, rate_hz=rate_hz,
+                     units=gyro_units, format=log_format or LogFormat())
 
 
-def _read_log(rep: Report, log: Path, gyro_units: str, log_format: LogFormat | None, columns: str | None,
-              rate_hz: float | None):
-    """The rate-table log as the report's options say; its errors name the report's own inputs."""
-    time_col, cols = _log_columns(columns, rate_hz)
-    try:
-        return read_sensor_log(rep.source(log), cols, gyro_units, time_col, rate_hz, log_format=log_format)
-    except AlignError as exc:
-        raise type(exc)(template(exc, LOG_FIELDS)) from None
+def _as_shown(r, shown: dict):
+    """A result run on staged copies (the demo) with its inputs and provenance naming the files as shown."""
+    import dataclasses
+
+    if all(str(k) == str(v) for k, v in shown.items()):
+        return r
+    paths = {str(k): str(v) for k, v in shown.items()}
+    inputs = {k: paths.get(v, v) if isinstance(v, str) else v for k, v in r.inputs.items()}
+    prov = r.provenance
+    if prov is not None:
+        prov = dataclasses.replace(prov, files=tuple(dataclasses.replace(f, path=paths.get(f.path, f.path))
+                                                     for f in prov.files))
+    return r.replace(inputs=inputs, provenance=prov)
 
 
 def alignment_job(rep: Report, allow, log: Path | None = None, plan: Path | None = None, result: Path | None = None,
                   gyro_units: str = "deg/s", log_format: LogFormat | None = None, columns: str | None = None,
-                  rate_hz: float | None = None) -> None:
-    """The electronic alignment from a log and its plan, or from a result file; the measured misalignment
-    against the allowance (:mod:`align.present.measured`).
+                  rate_hz: float | None = None, time_column: str | None = None) -> None:
+    """The electronic alignment from a log and its plan (the ``matrix`` job, :data:`align.alignment.jobs.MATRIX`),
+    or from a result file; the measured misalignment against the allowance (:mod:`align.present.measured`).
 
-    ``log_format``, ``columns`` (``time,x,y,z``; ``x,y,z`` with ``rate_hz``) and ``rate_hz``: how to read the log
-    (None: a plain CSV ``time,gyro_x,gyro_y,gyro_z``); for a result file, None keeps what it recorded.
+    ``log_format``, ``columns`` (``x,y,z`` with ``time_column``, default ``time``; ``time,x,y,z``; ``x,y,z`` with
+    ``rate_hz``) and ``rate_hz``: how to read the log, with the meaning ``matrix`` gives them (None: a plain CSV
+    ``time,gyro_x,gyro_y,gyro_z``); for a result file, None keeps what it recorded.
     """
     from align.present.alignsection import alignment_section
     from align.present.reread import reread_alignment_log
@@ -173,15 +201,19 @@ def alignment_job(rep: Report, allow, log: Path | None = None, plan: Path | None
         png = None if got is None else segmentation_plot_png(got.t, got.data, r, r.units)
         rep.inputs["alignment result"] = (str(result), "")
     else:
-        from align.alignment.job import align
-        from align.alignment.plan import Plan
+        from align.alignment.jobs import MATRIX, MatrixOptions
+        from align.errors import InputError
 
-        the_plan = Plan.from_dict(read_toml(rep.source(plan)), str(plan))
-        got = _read_log(rep, log, gyro_units, log_format, columns, rate_hz)
-        r = align(got.t, got.data, the_plan, units=got.shown, where=str(log))
-        r = r.replace(notes=r.notes + tuple(filter(None, [got.time_note()])),
-                      inputs={"log": str(log), "plan": str(plan), "gyro_units": gyro_units,
-                              "columns": columns or "time,gyro_x,gyro_y,gyro_z", "rate_hz": rate_hz, **got.inputs()})
+        if log is None or plan is None:
+            raise InputError("give a rate-table log and its plan, or an alignment result", "{log}")
+        try:  # the job's defaults, as `matrix` with no options; its errors name the report's own inputs
+            opts = MatrixOptions(log=_log_source(rep, log, gyro_units, log_format, columns, rate_hz, time_column),
+                                 plan=Path(rep.source(plan)))
+            r, inputs = MATRIX.run_with_inputs(opts)
+        except InputError as exc:
+            raise type(exc)(template(exc, LOG_FIELDS)) from None
+        r = _as_shown(r, {opts.log.path: log, opts.plan: plan})  # the files as shown (the demo reads staged copies)
+        got = inputs.log
         png, why = segmentation_plot_png(got.t, got.data, r, r.units), ""
         rep.inputs["rate-table log"] = (str(log), "")
         rep.inputs["plan"] = (str(plan), rep.text(plan))
@@ -227,31 +259,51 @@ def _measured(rep: Report, r, allow) -> None:
                      f"± {w.sigma / DEG:.4f} deg, limit {w.limit / DEG:.4f} deg; guard band {w.k:g} sigma)")
 
 
-def allan_job(rep: Report, allan: Path, columns: str, rate_hz: float | None, units: str, table_rate: str,
-              accuracy: str, noise_ratio: float, log_format: LogFormat | None) -> None:
-    """The Allan deviation of a static record (or an Allan result file), and the test plan from it (gyro data)."""
-    from align.noise import plan_from_allan, run_allan
-    from align.noise.job import AllanJob
+def allan_job(rep: Report, allan: Path, columns: str | None = None, rate_hz: float | None = None,
+              units: str | None = "deg/s", table_rate: str = "100 deg/s", accuracy: str = "0.1 deg",
+              noise_ratio: float = 10.0, log_format: LogFormat | None = None, *, options=None) -> None:
+    """The Allan deviation of a static record (or an Allan result file), and the test plan from it (gyro data).
+
+    The record is read, checked and analysed by the ``allan`` job (:data:`align.noise.jobs.ALLAN`), so every
+    option of ``allan REC`` means the same here. ``options`` (an :class:`~align.noise.jobs.AllanOptions`, e.g.
+    from the command line's ``align.cli.allan.allan_options``) gives them all; without it they are built from
+    ``columns``, ``rate_hz``, ``units`` (any rate or acceleration unit, or the size of one count) and
+    ``log_format``. The plan is made for gyro records, at ``table_rate`` and ``accuracy`` unless ``options``
+    states its own ``rate`` and ``accuracy``.
+    """
+    import dataclasses
+
+    from align.noise import plan_from_allan
+    from align.noise.analysis import AllanAnalysis
+    from align.noise.jobs import ALLAN, AllanOptions, allan_unit
     from align.present.noisesection import allan_section
     from align.present.plots import allan_plot_png
 
     if Path(allan).suffix.lower() == ".json":
         from align.results import load_result
 
-        job = load_result(rep.source(allan), (AllanJob,))
+        job = load_result(rep.source(allan), (AllanAnalysis,))
+        job = job.replace(plan=None)  # planned again at the report's rate and accuracy
         rep.inputs["Allan result"] = (str(allan), "")
     else:
-        names = [c.strip() for c in columns.split(",")]
-        parse_unit(units, "angular_rate", "{allan_units}")  # the plan needs a gyro's record
-        data, fs = read_static(rep.source(allan), names, rate_hz, log_format)
-        job = run_allan([data], fs, names, units, where=str(allan))
-        job = job.replace(inputs=(str(allan),))
+        if options is None:
+            options = AllanOptions(logs=(Path(allan),), columns=None if columns is None else tuple(columns.split(",")),
+                                   rate_hz=rate_hz, units=units,
+                                   format=log_format or LogFormat())
+        gyro = parse_unit(allan_unit(options.gyro_units, options.units)[0]).dim == parse_unit("rad/s").dim
+        plan_at = {} if options.rate is not None else {"rate": q(table_rate, "angular_rate", "{rate}"),
+                                                        "accuracy": q(accuracy, "angle", "{accuracy}"),
+                                                        "noise_ratio": noise_ratio}
+        options = dataclasses.replace(options, logs=tuple(Path(rep.source(p)) for p in options.logs),
+                                      **(plan_at if gyro else {"rate": None, "accuracy": None}))
+        job = ALLAN.run(options).replace(inputs=(str(allan),))
         rep.inputs["static record"] = (str(allan), "")
-    pl = None
-    if job.sensor == "gyroscope":
+    pl = job.plan
+    if pl is None and job.sensor == "gyroscope":
         pl = plan_from_allan(job, q(table_rate, "angular_rate", "{rate}"), q(accuracy, "angle", "{accuracy}"), noise_ratio,
                              "measured curve (worst channel)")
         job = job.replace(plan=pl)
+    if pl is not None:
         rep.results["plan"] = pl
         avg = "infeasible" if pl.averaging.tau is None else f"{pl.averaging.tau:.4g} s per step"
         rep.lines.append(f"plan: noise target {pl.noise_target / DEG_H:.2f} deg/h at {table_rate}, {accuracy}: averaging {avg}")
@@ -267,7 +319,7 @@ def allan_job(rep: Report, allan: Path, columns: str, rate_hz: float | None, uni
     arw = {n: f["ieee_point_readouts"].get("N_at_tau_1s") for n, f in fits.items()}
     known = {n: v for n, v in arw.items() if v is not None}
     if known:
-        n = max(known, key=known.get)
+        n = max(known, key=lambda k: known[k])
         unit = fits[n]["ieee_point_readouts"]["N_unit"]
         rep.verdicts.append(Verdict("noise: N at tau = 1 s", INFO, f"{known[n]:.4g} {unit} ({n})", known[n],
                                     "the worst channel's random walk (IEEE point readout)"))
@@ -279,6 +331,7 @@ def calibration_job(rep: Report, path: Path) -> None:
     from align.calibration.results import CalibrationSet
     from align.present.calsection import calibration_section, magnetometer_section
     from align.results import load_result
+    from align.vocab import Status
 
     res = load_result(rep.source(path), (CalibrationSet, MagCalibration))
     name = Path(path).stem
@@ -292,7 +345,7 @@ def calibration_job(rep: Report, path: Path) -> None:
         if raw is not None:
             png, why = magnetometer_png(raw[:, -3:], res), ""
         rep.add("calibration", magnetometer_section(res, str(path), png, in_words(why)))
-        rep.verdicts.append(Verdict(f"magnetometer ({name})", INFO, f"heading error {res.heading_error / DEG:.3f} deg",
+        rep.verdicts.append(Verdict(f"magnetometer ({name})", Status.INFO, f"heading error {res.heading_error / DEG:.3f} deg",
                                     res.heading_error / DEG, f"predicted, 1 sigma; field spread {100 * res.spread_before:.2f} % "
                                     f"before, {100 * res.spread_after:.2f} % after"))
         rep.lines.append(f"magnetometer {path}: predicted heading error {res.heading_error / DEG:.3f} deg, "
@@ -309,7 +362,7 @@ def calibration_job(rep: Report, path: Path) -> None:
         from align.present.figures import display_unit
 
         factor, shown = display_unit(cal.units)
-        rep.verdicts.append(Verdict(f"{kind} calibration ({name})", INFO,
+        rep.verdicts.append(Verdict(f"{kind} calibration ({name})", Status.INFO,
                                     f"largest {what} {worst_v / factor:.3g} {shown}", worst_v / factor,
                                     f"{cal.method}; {_count(pool, cal.sensor)}"))
         rep.lines.append(f"{kind} calibration {path}: {cal.method}, largest {what} {worst_v / factor:.3g} {shown}")
@@ -317,11 +370,13 @@ def calibration_job(rep: Report, path: Path) -> None:
             rep.lines.append(Said("  " + why))
 
 
-def _count(pool: dict, sensor: str) -> str:
+def _count(pool: dict, sensor: str) -> str:  # a Sensor, or its value
     """``10 attitudes``, ``6 rotations``: the residuals' own word (``attitude 1``) or the sensor's usual one."""
+    from align.vocab import Sensor
+
     first = next(iter(pool), "")
     word = first.split()[0] if " " in first and first.split()[-1].isdigit() else (
-        "rotation" if sensor == "gyroscope" else "position")
+        "rotation" if Sensor.parse(sensor) is Sensor.GYROSCOPE else "position")
     return f"{len(pool)} {word}{'' if len(pool) == 1 else 's'}"
 
 

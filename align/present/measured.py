@@ -32,6 +32,7 @@ from align.present.html import Section, table
 from align.present.verdicts import FAIL, PASS, WARN, angle_sigmas
 from align.sensitivity.symbolic import ELEMENTS
 from align.units import DEG
+from align.vocab import Status
 
 #: the guard band, in units of the 1-sigma
 GUARD_K = 2.0
@@ -50,7 +51,7 @@ def guard(margin: float, sigma: float, k: float = GUARD_K) -> str:
     return WARN
 
 
-def worst_status(statuses) -> str:
+def worst_status(statuses) -> Status:
     """FAIL over WARN over PASS (``"-"`` ignored; PASS when nothing was judged)."""
     s = set(statuses)
     return FAIL if FAIL in s else WARN if WARN in s else PASS
@@ -161,9 +162,9 @@ def output_margins(m: np.ndarray, sigma_m: np.ndarray, mounting: np.ndarray | No
     e0, h = errors(m), 1e-7
     jac = np.zeros((len(names), 9))
     for j in range(9):
-        d = np.zeros(9)
-        d[j] = h
-        d = d.reshape(3, 3)
+        step = np.zeros(9)
+        step[j] = h
+        d = step.reshape(3, 3)
         jac[:, j] = (errors(m + d) - errors(m - d)) / (2 * h)
     sigma = np.sqrt((jac**2) @ np.square(np.asarray(sigma_m, float)).ravel())
     return [OutputMargin(o, float(e0[i]), float(sigma[i]), float(man.limits[o]), k) for i, o in enumerate(names)]
@@ -195,7 +196,8 @@ def measured_margins(result, allow, k: float = GUARD_K) -> list[MeasuredMargin]:
 
 
 def _cls(status: str) -> str:
-    return {PASS: "pass", FAIL: "fail", WARN: "warn"}.get(status, "")
+    classes: dict[str, str] = {PASS: "pass", FAIL: "fail", WARN: "warn"}
+    return classes.get(status, "")
 
 
 def _s(x: float) -> str:
@@ -238,7 +240,7 @@ def measured_section(outputs: list[OutputMargin], rows: list[MeasuredMargin], k:
     return Section("Measured misalignment against the allowance", body)
 
 
-def describe(outputs: list[OutputMargin], rows: list[MeasuredMargin]) -> tuple[str, OutputMargin, str]:
+def describe(outputs: list[OutputMargin], rows: list[MeasuredMargin]) -> tuple[Status, OutputMargin, str]:
     """``(status, the output of smallest margin in sigmas, one line of detail)`` for the summary."""
     status = worst_status(o.status for o in outputs)
     w = min(outputs, key=lambda o: o.margin)

@@ -37,13 +37,13 @@ def _term_label_at(y: np.ndarray, lo: float, hi: float, falling: bool, j: int) -
 
 def _short_names(names: tuple) -> list[str]:
     """Channel names without their common prefix and suffix (``gyro_x_dps`` -> ``x``), when that leaves them distinct."""
-    names = [str(n) for n in names]
-    if len(names) < 2:
-        return names
-    pre = len(os.path.commonprefix(names))
-    suf = len(os.path.commonprefix([n[::-1] for n in names]))
-    short = [n[pre : len(n) - suf] for n in names]
-    return short if all(short) and len(set(short)) == len(short) else names
+    full = [str(n) for n in names]
+    if len(full) < 2:
+        return full
+    pre = len(os.path.commonprefix(full))
+    suf = len(os.path.commonprefix([n[::-1] for n in full]))
+    short = [n[pre : len(n) - suf] for n in full]
+    return short if all(short) and len(set(short)) == len(short) else full
 
 
 def allan_ylim(job: AllanJob, shown: str, target: float | None = None) -> tuple[float, float]:

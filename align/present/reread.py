@@ -26,7 +26,7 @@ from align.errors import AlignError, literal
 from align.io import LogFormat, read_sensor_log, read_toml
 
 #: a rate-table log's reading fields as the report names them (its static record has ``columns`` and ``rate_hz``)
-LOG_FIELDS = {"columns": "gyro_columns", "rate_hz": "log_rate_hz"}
+LOG_FIELDS = {"columns": "gyro_columns", "rate_hz": "log_rate_hz", "time_column": "log_time_column"}
 _FORMAT = ("skip_rows", "comment", "delimiter", "time_units")
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -18,7 +19,7 @@ from align.present.figures import COLOURS, envelope, png_bytes, pyplot, zigzag
 from align.units import DEG_S, parse_unit
 
 #: colours (and hatch) of the spans of a segmentation picture, by kind
-_SPAN_STYLE = {
+_SPAN_STYLE: dict[str, dict[str, Any]] = {
     "step": {"facecolor": "#f6c343", "alpha": 0.35, "label": "plan step (dwell or turn)"},
     "static": {"facecolor": "#8fd1c4", "alpha": 0.35, "label": "static period"},
     "motion": {"facecolor": "#d9c2ec", "edgecolor": "#7b3f9e", "hatch": "///", "alpha": 0.55,
@@ -204,6 +205,7 @@ def segmentation_plot_png(t: np.ndarray, g: np.ndarray, result, units: str = "de
     scale = parse_unit(units, "angular_rate", "{gyro_units}").factor
     spans = segmentation_spans(t, g, result)
     plt = pyplot()
+    from matplotlib.artist import Artist
     from matplotlib.font_manager import FontProperties
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
@@ -257,7 +259,7 @@ def segmentation_plot_png(t: np.ndarray, g: np.ndarray, result, units: str = "de
         ("step", ("plan step", "plan steps")), ("static", ("static period", "static periods")),
         ("motion", ("motion that no step claimed", "motions that no step claimed")), ("ramp", ("ramp", "ramps")))
         if count[k] or k == "step"), fontsize=9)  # kinds that are absent are left out (no "0 motions")
-    handles = [Line2D([], [], color=c, lw=1.2, label=f"gyro {'xyz'[j]}") for j, c in enumerate(COLOURS[:3])]
+    handles: list[Artist] = [Line2D([], [], color=c, lw=1.2, label=f"gyro {'xyz'[j]}") for j, c in enumerate(COLOURS[:3])]
     handles += [Patch(**st) for k, st in _SPAN_STYLE.items() if count[k]]
     lg.legend(handles=handles, loc="upper center", ncol=len(handles), fontsize=9, frameon=False,
               bbox_to_anchor=(0.5, -0.32))

@@ -19,6 +19,7 @@ import dataclasses
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -123,7 +124,8 @@ def make_report(mount: Path | None = None, manoeuvre: Path | None = None, log: P
                 log_format: LogFormat | None = None, alignment: Path | None = None, calibrations: Sequence[Path] = (),
                 drift: Sequence[Path] = (), header: dict | None = None, parts: Mapping | None = None,
                 log_columns: str | None = None, log_rate_hz: float | None = None,
-                spell: Callable[[str, str | None], str] | None = None) -> Outcome:
+                spell: Callable[[str, str | None], str] | None = None, allan_options: Any = None,
+                log_time_column: str | None = None) -> Outcome:
     """Run every job whose inputs are given, from any subset of them, and build the report.
 
     Parameters
@@ -135,6 +137,12 @@ def make_report(mount: Path | None = None, manoeuvre: Path | None = None, log: P
     log_columns, log_rate_hz : str, float, optional
         The log's columns (``time,x,y,z``; ``x,y,z`` with ``log_rate_hz``, Hz, for a log without time); None: a
         log's ``time,gyro_x,gyro_y,gyro_z``, and for an alignment result file what it recorded.
+    log_time_column : str, optional
+        The log's time column (``matrix``'s ``time_column``; default ``time``).
+    allan_options : AllanOptions, optional
+        Every option of the ``allan`` job for the static record (:class:`align.noise.jobs.AllanOptions`, e.g.
+        from ``align.cli.allan.allan_options``); None: built from ``allan_columns``, ``allan_rate_hz``,
+        ``allan_units`` and ``log_format``.
     allan : Path, optional
         A static record (``allan_columns``, ``allan_rate_hz``, ``allan_units``) or an Allan result file (``.json``);
         a gyro's gives the test plan for ``table_rate``, ``accuracy``, ``noise_ratio``.
@@ -188,14 +196,16 @@ def make_report(mount: Path | None = None, manoeuvre: Path | None = None, log: P
     b = m = None
     if mount is not None:
         b, m = jobs.mount_job(rep, mount, monte_carlo, seed, progress, parts)
-    allow = jobs.manoeuvre_job(rep, manoeuvre, b, m, basis, monte_carlo)
+    allow = jobs.manoeuvre_job(rep, manoeuvre, b, m, basis, monte_carlo, mount_path=mount)
     if log is not None or alignment is not None:
-        jobs.alignment_job(rep, allow, log, plan, alignment, gyro_units, log_format, log_columns, log_rate_hz)
+        jobs.alignment_job(rep, allow, log, plan, alignment, gyro_units, log_format, log_columns, log_rate_hz,
+                           time_column=log_time_column)
     elif allow is not None and b is None:
         rep.verdicts.append(Verdict("allowance", INFO, f"binding {allow.binding} = {allow.binding_value / DEG:.4f} deg",
                                     allow.binding_value / DEG, "no budget or alignment given to check against it"))
     if allan is not None:
-        jobs.allan_job(rep, allan, allan_columns, allan_rate_hz, allan_units, table_rate, accuracy, noise_ratio, log_format)
+        jobs.allan_job(rep, allan, allan_columns, allan_rate_hz, allan_units, table_rate, accuracy, noise_ratio, log_format,
+                       options=allan_options)
     for path in calibrations:
         jobs.calibration_job(rep, path)
     for path in drift:  # the error growth of a navigation result

@@ -10,7 +10,8 @@ the measured misalignment against the manoeuvre is :mod:`align.present.measured`
 
 Public names
 ------------
-Verdict, angle_vector, angle_sigmas, summary_section, worst, ANGLE_NAMES, PASS, FAIL, WARN, INFO
+Verdict, angle_vector, angle_sigmas, summary_section, worst, ANGLE_NAMES, PASS, FAIL, WARN, INFO, NOT_CHECKED
+(the members of :class:`align.vocab.Status`, the one verdict type)
 """
 
 from __future__ import annotations
@@ -20,8 +21,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from align.present.html import Section, esc, table
+from align.vocab import Status
 
-PASS, FAIL, WARN, INFO = "PASS", "FAIL", "WARN", "INFO"
+PASS, FAIL, WARN, INFO, NOT_CHECKED = Status.PASS, Status.FAIL, Status.WARN, Status.INFO, Status.NOT_CHECKED
 #: the angles :func:`angle_vector` returns, in order
 ANGLE_NAMES = ("psi_x", "psi_y", "psi_z", "phi_xy", "phi_xz", "phi_yx", "phi_yz", "phi_zx", "phi_zy",
                "delta_xy", "delta_xz", "delta_yz", "rot_x", "rot_y", "rot_z")
@@ -35,8 +37,9 @@ class Verdict:
     ----------
     check : str
         What was checked (``"measured misalignment vs allowance"``).
-    status : {"PASS", "FAIL", "WARN", "INFO"}
-        ``WARN``: a caution that fails nothing; ``INFO``: a result shown without a requirement to meet.
+    status : Status
+        ``WARN``: a caution that fails nothing; ``NOT CHECKED``: a requirement that could not be judged (never
+        counted as passed); ``INFO``: a result shown without a requirement to meet.
     number : str
         The one number behind the verdict, with its unit, as shown.
     value : float
@@ -50,12 +53,15 @@ class Verdict:
     """
 
     check: str
-    status: str
+    status: Status
     number: str
     value: float = float("nan")
     detail: str = ""
     design: bool = False
     governs: bool = True
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "status", Status.parse(self.status))
 
     @property
     def failed(self) -> bool:
@@ -114,9 +120,9 @@ def angle_sigmas(m: np.ndarray, sigma_m: np.ndarray, mounting: np.ndarray | None
     h = 1e-7
     jac = np.zeros((len(ANGLE_NAMES), 9))
     for k in range(9):
-        d = np.zeros(9)
-        d[k] = h
-        d = d.reshape(3, 3)
+        flat = np.zeros(9)
+        flat[k] = h
+        d = flat.reshape(3, 3)
         jac[:, k] = (angle_vector((m + d) @ n.T) - angle_vector((m - d) @ n.T)) / (2 * h)
     var = (jac**2) @ np.square(np.asarray(sigma_m, float)).ravel()
     return dict(zip(ANGLE_NAMES, np.sqrt(var).tolist()))
@@ -129,7 +135,7 @@ def worst(rows: list) -> object:
 
 
 def _cls(status: str) -> str:
-    return {PASS: "pass", FAIL: "fail", WARN: "warn"}.get(status, "info")
+    return {PASS: "pass", FAIL: "fail", WARN: "warn", NOT_CHECKED: "warn"}.get(Status.parse(status), "info")
 
 
 def summary_section(verdicts: list[Verdict]) -> Section:
@@ -139,18 +145,26 @@ def summary_section(verdicts: list[Verdict]) -> Section:
     governing = [v for v in verdicts if v.governs]
     failed = [v for v in governing if v.status == FAIL]
     warned = [v for v in governing if v.status == WARN]
-    checked = [v for v in governing if v.status in (PASS, FAIL, WARN)]
+    checked = [v for v in governing if v.status.judged]
+    unchecked = [v for v in governing if v.status == NOT_CHECKED]
     n = f"{len(checked)} check{'s' if len(checked) != 1 else ''}"
     cautions = "" if not warned else (f" {len(warned)} WARN ({esc(', '.join(v.check for v in warned))}): within the "
                                       "guard band of a limit, or a caution.")
+    if unchecked:  # never counted as passed, and said in the banner
+        cautions += (f" {len(unchecked)} NOT CHECKED ({esc(', '.join(v.check for v in unchecked))}): "
+                     "the data or the limit to judge it were not there.")
     if failed:
         head = (f'<p class="banner fail">FAIL: {len(failed)} of {n} failed ({esc(", ".join(v.check for v in failed))}).'
                 f"{cautions}</p>")
     elif warned:
         head = f'<p class="banner warn">WARN: none of {n} failed;{cautions}</p>'
+    elif checked and unchecked:
+        head = (f'<p class="banner warn">PASS on the {n} that ran, but not everything was checked:{cautions}</p>')
     elif checked:
         head = ('<p class="banner pass">PASS: ' + ("the one check passed" if len(checked) == 1
                                                    else f"all {len(checked)} checks passed") + ".</p>")
+    elif unchecked:
+        head = f'<p class="banner warn">NOT CHECKED: no requirement could be judged.{cautions}</p>'
     else:
         head = '<p class="banner info">No requirement was given: the results below are reported without a verdict.</p>'
     design = [v for v in verdicts if not v.governs and v.status in (FAIL, WARN)]

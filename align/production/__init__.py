@@ -12,17 +12,29 @@ spec       limits per figure (TOML, units at the edge)
 stats      count, mean, spread, Cpk, yield, outliers, trend, control limits; a unit's verdict
 rehearsal  a simulated lot with known truth
 
-The command line (``imu-align batch``, ``imu-align lot``) supplies the worker that runs a unit's
-single command; nothing here runs a job of its own.
+A unit runs its library job (``align.api.job(name).run(options)``, :func:`run_job`) in a worker; the
+command line (``imu-align batch``, ``imu-align lot``) builds each unit's options from its manifest row
+with the command's own parser and supplies the wording of a unit's failure.
 
 Public names
 ------------
 Unit, Manifest, read_manifest, input_hash, result_rows, FIGURES, SCHEMA, append_rows, read_table, latest_rows,
-Journal, make_pool, Task, BatchRun, plan_tasks, run_units, unit_rows, error_rows, Limit, Spec, read_spec,
-lot_statistics, judge_rows, LotStats, FigureStats, LotSpread, LotTruth, simulate_lot
+Journal, make_pool, Task, BatchRun, plan_tasks, run_units, run_job, unit_rows, result_unit_rows, error_rows, Limit, Spec,
+read_spec, lot_statistics, judge_rows, LotStats, FigureStats, LotSpread, LotTruth, simulate_lot
 """
 
-from align.production.batch import TABLE, UNITS, BatchRun, Task, error_rows, plan_tasks, run_units, unit_rows
+from align.production.batch import (
+    TABLE,
+    UNITS,
+    BatchRun,
+    Task,
+    error_rows,
+    plan_tasks,
+    result_unit_rows,
+    run_job,
+    run_units,
+    unit_rows,
+)
 from align.production.figures import FIGURES, result_rows
 from align.production.manifest import Manifest, Unit, input_hash, read_manifest
 from align.production.pools import make_pool
@@ -31,7 +43,8 @@ from align.production.spec import Limit, Spec, read_spec
 from align.production.stats import FigureStats, LotStats, judge_rows, lot_statistics
 from align.production.table import SCHEMA, Journal, append_rows, latest_rows, read_table
 
-__all__ = ["TABLE", "UNITS", "BatchRun", "Task", "error_rows", "plan_tasks", "run_units", "unit_rows", "FIGURES",
-           "result_rows", "Manifest", "Unit", "input_hash", "read_manifest", "make_pool", "LotSpread", "LotTruth",
+__all__ = ["TABLE", "UNITS", "BatchRun", "Task", "error_rows", "plan_tasks", "run_units", "run_job", "unit_rows",
+           "result_unit_rows", "FIGURES", "result_rows", "Manifest", "Unit", "input_hash", "read_manifest", "make_pool",
+           "LotSpread", "LotTruth",
            "simulate_lot", "Limit", "Spec", "read_spec", "FigureStats", "LotStats", "judge_rows", "lot_statistics",
            "SCHEMA", "Journal", "append_rows", "latest_rows", "read_table"]

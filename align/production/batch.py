@@ -1,11 +1,13 @@
 """A batch: every unit of a manifest through its single-unit job, in parallel, resumable.
 
-The batch itself runs no job: it hands each unit's :class:`Task` (the single command's words,
-its result file, its input files) to a ``worker`` (the command line's, which runs the single
-command in its process and reads its result back) through a pool (:mod:`align.production.pools`),
-and appends the rows the worker returns to the lot's table through a journal
-(:class:`align.production.table.Journal`): per unit as it finishes, so that a killed batch keeps
-what was done.
+The batch hands each unit's :class:`Task` (the job's name and its options, built in the parent from the
+manifest row by the command's own parser and options builder; its result file; its input files) to a
+worker through a pool (:mod:`align.production.pools`). The worker (:func:`run_job`) calls the library
+job (``align.api.job(name).run(options)``), writes the JSON result and the extra files the unit's output
+options ask for (all or none, :class:`align.io.outputs.Outputs`) and returns the table rows made from the
+result in memory (:func:`align.production.figures.result_rows`). The rows are appended to the lot's table
+through a journal (:class:`align.production.table.Journal`): per unit as it finishes, so that a killed
+batch keeps what was done.
 
 Resuming: a unit is skipped when its result file exists and the table's latest row for it (serial
 and job) succeeded with the same content hash of its inputs (:func:`align.production.manifest.input_hash`:
@@ -15,7 +17,7 @@ result of other inputs behind.
 
 Public names
 ------------
-Task, BatchRun, plan_tasks, run_units, unit_rows, error_rows, locked, TABLE, UNITS
+Task, BatchRun, plan_tasks, run_units, run_job, unit_rows, result_unit_rows, error_rows, locked, TABLE, UNITS
 """
 
 from __future__ import annotations
@@ -23,10 +25,11 @@ from __future__ import annotations
 import os
 import socket
 import time
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from align.errors import AlignError, InputError
 from align.production.figures import result_rows
@@ -50,25 +53,33 @@ class Task:
     Attributes
     ----------
     unit : Unit
-    args : tuple of str
-        The single command's words, e.g. ``("matrix", LOG, <plan option>, PLAN, ..., <json option>, RESULT)``.
     result : Path
         The unit's result file, ``OUT/units/SERIAL.JOB.json``.
     inputs : tuple of Path or None
-        The files the content hash covers (log, plan, input files the options name).
+        The files the content hash covers (log, plan, the job's other input files).
     run : str
         The batch run's id (its start, UTC).
+    options : object, optional
+        The job's frozen options (``align.api.job(unit.job).options``), built from the manifest row.
+    params : mapping, optional
+        The command's parameters (plain values) when the unit's output options ask for extra files (a plot,
+        a C header): what the job's files builder takes; empty when only the JSON result is written.
+    refused : (int, str), optional
+        The exit status and one-line message of a unit whose options the job refused before it ran.
     """
 
     unit: Unit
-    args: tuple[str, ...]
     result: Path
     inputs: tuple[Path | None, ...]
     run: str
+    options: Any = None
+    params: Mapping[str, Any] = field(default_factory=dict)
+    refused: tuple[int, str] | None = None
 
-    def digest(self) -> str:
-        """The content hash of the unit's inputs now."""
-        return input_hash(self.unit.job, self.unit.options, self.inputs)
+    def digest(self, known: Mapping[str, str] | None = None) -> str:
+        """The content hash of the unit's inputs now (``known``: path -> SHA-256 of files hashed already, see
+        :func:`align.production.manifest.input_hash`)."""
+        return input_hash(self.unit.job, self.unit.options, self.inputs, known)
 
 
 @dataclass
@@ -102,7 +113,7 @@ class BatchRun:
         worst: dict[str, dict] = {}
         for r in rows:
             have = worst.get(r["serial"])
-            if have is None or _RANK.get(r.get("verdict"), 0) > _RANK.get(have.get("verdict"), 0):
+            if have is None or _RANK.get(str(r.get("verdict")), 0) > _RANK.get(str(have.get("verdict")), 0):
                 worst[r["serial"]] = r
         return [r for r in worst.values()
                 if (status is None or r["status"] == status) and (verdict is None or r["verdict"] == verdict)]
@@ -131,20 +142,82 @@ def error_rows(task: Task, status: str, exit_code: int, message: str, digest: st
              "bias_unit": None}]
 
 
-def unit_rows(task: Task, exit_code: int, message: str, digest: str, seconds: float) -> list[dict]:
-    """The rows of a unit whose job ran: its figures read back from its result file when it succeeded
-    (exit status 0), else one row ``"failed"`` (status 2, 3, 4: the job refused it) or ``"error"`` (any other)."""
-    if exit_code != 0:
-        return error_rows(task, "failed" if exit_code in (2, 3, 4) else "error", exit_code, message, digest, seconds)
-    from align.results import load_result
-
-    try:
-        found = result_rows(load_result(task.result))
-    except AlignError as exc:
-        return error_rows(task, "error", 1, f"the result cannot be read back: {exc}", digest, seconds)
+def result_unit_rows(task: Task, result, message: str, digest: str, seconds: float) -> list[dict]:
+    """The rows of a unit whose job gave ``result`` (in memory): one per sensor with its figures
+    (:func:`align.production.figures.result_rows`), status ``"ok"``."""
     stamp = now()
+    found = result_rows(result) if result is not None else []
     return [{**_base(task), "time": stamp, "status": "ok", "exit_code": 0, "message": message, "input_hash": digest,
              "seconds": seconds, **r} for r in (found or [{"sensor": None, "verdict": "pass", "checks": ""}])]
+
+
+def unit_rows(task: Task, exit_code: int, message: str, digest: str, seconds: float, result=None) -> list[dict]:
+    """The rows of a unit whose job ran: its figures from ``result`` when it succeeded (exit status 0), else one
+    row ``"failed"`` (status 2, 3, 4: the job refused it) or ``"error"`` (any other)."""
+    if exit_code != 0:
+        return error_rows(task, "failed" if exit_code in (2, 3, 4) else "error", exit_code, message, digest, seconds)
+    return result_unit_rows(task, result, message, digest, seconds)
+
+
+def _say(job: str, exc: BaseException) -> tuple[int, str]:
+    """A failure as a bare library caller sees it (the command line gives the batch its own wording)."""
+    if isinstance(exc, AlignError):
+        return exc.exit_code, f"imu-align: error: {' '.join(str(exc).split())}"
+    return 1, f"imu-align: internal error: {' '.join(f'{type(exc).__name__}: {exc}'.split())[:300]}"
+
+
+def run_job(task: Task, files: Callable | None = None,
+            say: Callable[[str, BaseException], tuple[int, str]] | None = None) -> list[dict]:
+    """Run one unit's job in this process and return its table rows (the worker of a batch).
+
+    ``align.api.job(task.unit.job).run(task.options)`` (``run_with_inputs`` when the unit asks for extra files);
+    the JSON result and the extra files are written all or none; the rows are made from the result in memory.
+
+    Parameters
+    ----------
+    task : Task
+    files : callable, optional
+        The job's files builder, ``files(result, inputs, params) -> [(Path, bytes or str)]``: called when
+        ``task.params`` is not empty.
+    say : callable, optional
+        ``say(job, exc) -> (exit status, one line)``: a failure as the job's command says it.
+
+    Returns
+    -------
+    list of dict
+        The unit's rows: one per sensor, or one ``"failed"`` / ``"error"`` row with the one-line message.
+    """
+    import warnings
+
+    from align.api import job as find
+    from align.io.outputs import Outputs
+
+    say = say or _say
+    started = time.perf_counter()
+    if task.refused is not None:
+        return unit_rows(task, *task.refused, task.digest(), 0.0)
+    try:
+        with warnings.catch_warnings():  # as the command line: a result that cannot be trusted is refused instead
+            warnings.simplefilter("ignore")
+            job = find(task.unit.job)
+            if task.params and files is not None:  # extra files: the job's checked inputs are drawn too
+                result, inputs = job.run_with_inputs(task.options)
+                extra = files(result, inputs, task.params)
+            else:
+                result, extra = job.run(task.options), []
+            with Outputs() as out:  # all or none
+                out.write_json(task.result, result)
+                for path, data in extra:
+                    if isinstance(data, bytes):
+                        out.write_bytes(path, data)
+                    else:
+                        out.write_text(path, data)
+    except Exception as exc:  # the job refused the unit (its exit status), or failed inside (status 1)
+        code, message = say(task.unit.job, exc)
+        return unit_rows(task, code if code != 0 else 1, message, task.digest(), time.perf_counter() - started)
+    # the content hash from the bytes the job's provenance hashed (read once), the other inputs read now
+    read = {f.path: f.sha256 for f in getattr(result.provenance, "files", ())}
+    return result_unit_rows(task, result, "", task.digest(read), time.perf_counter() - started)
 
 
 def plan_tasks(units: Iterable[Unit], out: Path, make: Callable[[Unit, Path, str], Task],
@@ -158,7 +231,7 @@ def plan_tasks(units: Iterable[Unit], out: Path, make: Callable[[Unit, Path, str
     out : Path
         The output folder (holding ``units/`` and the table).
     make : callable
-        ``make(unit, result_path, run) -> Task``: the single command's words for the unit.
+        ``make(unit, result_path, run) -> Task``: the unit's job and options.
     run : str
         This run's id.
     rerun : bool

@@ -26,6 +26,8 @@ FIGURES, KIND, si_unit, shown_unit, result_rows, matrix_figures, AXES
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from align.model import angles
@@ -121,30 +123,31 @@ def result_rows(result: Result) -> list[dict]:
         Empty for a result of any other kind (the unit's row then holds no figures).
     """
     kind = type(result).FORMAT
+    res: Any = result  # one of the kinds below, told apart by its format
     if kind == "imu-align.alignment":
-        warn = [c for c in result.checks if c.status == "warn"]
-        row = {"sensor": "gyroscope", "checks": "; ".join(f"{c.name}: {c.status}" for c in result.checks),
+        warn = [c for c in res.checks if c.status == "warn"]
+        row = {"sensor": "gyroscope", "checks": "; ".join(f"{c.name}: {c.status}" for c in res.checks),
                "verdict": "warn" if warn else "pass", "bias_unit": "rad/s",
-               **matrix_figures(result.M, result.sigma_M, result.mounting),
-               **_vector("bias", result.bias, result.sigma_bias)}
+               **matrix_figures(res.M, res.sigma_M, res.mounting),
+               **_vector("bias", res.bias, res.sigma_bias)}
         return [row]
     if kind == "imu-align.calibration":
         rows = []
-        for sensor, cal in result.sensors.items():
+        for sensor, cal in res.sensors.items():
             held = ", ".join(f"{k}: {np.max(np.abs(v)):.3g}" for k, v in cal.checks.items())
             rows.append({"sensor": sensor, "checks": f"held out (largest |residual|, {cal.units}) {held}" if held else "",
                          "verdict": "pass", "bias_unit": _reading_unit(sensor, cal.units),
                          **matrix_figures(cal.M, cal.sigma_M), **_vector("bias", cal.bias, cal.sigma_bias)})
         return rows
     if kind == "imu-align.magnetometer":
-        w = np.asarray(result.soft_iron, float)
+        w = np.asarray(res.soft_iron, float)
         return [{"sensor": "magnetometer", "checks": "", "verdict": "pass",
-                 "bias_unit": _reading_unit("magnetometer", result.units),
-                 **matrix_figures(np.linalg.inv(w), None), **_vector("bias", result.hard_iron, result.sigma_hard_iron),
-                 "field": float(result.field), "coverage": float(result.coverage),
-                 "heading_error": float(result.heading_error), "spread": float(result.spread_after)}]
+                 "bias_unit": _reading_unit("magnetometer", res.units),
+                 **matrix_figures(np.linalg.inv(w), None), **_vector("bias", res.hard_iron, res.sigma_hard_iron),
+                 "field": float(res.field), "coverage": float(res.coverage),
+                 "heading_error": float(res.heading_error), "spread": float(res.spread_after)}]
     if kind == "imu-align.allan":
-        return [_allan_row(result)]
+        return [_allan_row(res)]
     return []
 
 

@@ -123,7 +123,8 @@ def read_manifest(path: str | Path, jobs: Mapping[str, str]) -> Manifest:
     if not records:
         raise InputError("lists no units; give one row per unit", str(p))
     folder = p.resolve().parent
-    units, seen = [], {}
+    units: list[Unit] = []
+    seen: dict[tuple[str, str], str] = {}
     for order, (row, record) in enumerate(records):
         unit = _unit(record, row, order, folder, jobs, str(p))
         key = (unit.serial.lower(), unit.job)  # case-only differences collide on case-insensitive file systems
@@ -230,20 +231,34 @@ def _unit(record: dict, row: str, order: int, folder: Path, jobs: Mapping[str, s
                 order, row)
 
 
-def input_hash(job: str, options: Iterable[str], files: Iterable[Path | None]) -> str:
+def input_hash(job: str, options: Iterable[str], files: Iterable[Path | None],
+               known: Mapping[str, str] | None = None) -> str:
     """The content hash (SHA-256, hex) of a unit's inputs: its job, its options as typed, and the bytes of
     each input file in order (a missing file hashes as missing, so that it counts as changed once it exists).
 
     Two units hash alike exactly when their job, options and input contents and the imu-align version
     (``align.__version__``: a release that changes an estimator reruns every unit) are the same; the
     files' names and times do not enter.
+
+    Parameters
+    ----------
+    job : str
+    options : iterable of str
+    files : iterable of Path or None
+    known : mapping of str -> str, optional
+        Path -> SHA-256 (hex) of files hashed already (a result's provenance, :class:`align.provenance.InputFile`):
+        not read again; an empty digest stands for a file that could not be read.
     """
     from align import __version__
 
     h = hashlib.sha256(b"imu-align batch inputs 1\0" + str(__version__).encode() + b"\0")
     h.update(hashlib.sha256("\0".join([job, *options]).encode()).digest())
     for path in files:
-        h.update(_file_digest(path))
+        hexed = None if path is None or not known else known.get(str(path))
+        if hexed is None:
+            h.update(_file_digest(path))
+        else:
+            h.update(bytes.fromhex(hexed) if hexed else b"missing")
     return h.hexdigest()
 
 

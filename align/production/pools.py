@@ -3,9 +3,10 @@
 Both pools have one interface, used by :func:`align.production.batch.run_units`: ``submit(fn, arg)`` returns
 a future, ``wait(futures)`` returns the ones done (at least one), ``future.result()`` the value or the
 worker's exception. The process pool is :class:`concurrent.futures.ProcessPoolExecutor` (workers ignore
-Ctrl-C: the batch that started them stops them). The Dask pool is a ``dask.distributed.Client``, on
-a running scheduler (``tcp://host:8786``) or on a local cluster of ``workers`` processes with one
-thread each (``"local"``); Dask is imported only then.
+Ctrl-C: the batch that started them stops them), its workers forks of the batch's process where that is
+safe (they start with the jobs' modules imported), else forked by a fork server that imported them once.
+The Dask pool is a ``dask.distributed.Client``, on a running scheduler (``tcp://host:8786``) or on a local
+cluster of ``workers`` processes with one thread each (``"local"``); Dask is imported only then.
 
 A cluster's workers must see the manifest's files and the output folder under the same absolute
 paths (a shared file system): each unit reads its inputs and writes its result where it runs.
@@ -18,9 +19,13 @@ ProcessPool, DaskPool, make_pool, BrokenPool
 from __future__ import annotations
 
 import concurrent.futures as cf
+import gc
 import multiprocessing as mp
 import os
 import signal
+import sys
+import threading
+from typing import Any
 
 from align.errors import InputError
 
@@ -30,23 +35,78 @@ CONNECT_TIMEOUT = 10.0
 BrokenPool = cf.BrokenExecutor
 
 
-def _ignore_interrupt() -> None:
+def _ignore_interrupt(preload: tuple[str, ...] = ()) -> None:
+    """A worker's start: Ctrl-C is the batch's to handle; the modules its units need imported (already there when
+    the fork server preloaded them)."""
+    import importlib
+
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    for name in preload:
+        try:
+            importlib.import_module(name)
+        except ImportError:  # the unit that needs it says why
+            pass
+
+
+def _fork_is_safe() -> bool:
+    """Whether a worker may be a fork of this process: on Linux, with no other thread running and numba's
+    parallel layer not started (a fork of a process whose OpenMP threads ran aborts in GNU OpenMP)."""
+    if sys.platform != "linux" or "fork" not in mp.get_all_start_methods() or threading.active_count() > 1:
+        return False
+    parallel = sys.modules.get("numba.np.ufunc.parallel")
+    return parallel is None or getattr(parallel, "_is_initialized", True) is False
 
 
 class ProcessPool:
-    """``workers`` processes on this machine (:class:`concurrent.futures.ProcessPoolExecutor`)."""
+    """``workers`` processes on this machine (:class:`concurrent.futures.ProcessPoolExecutor`).
 
-    def __init__(self, workers: int) -> None:
+    A worker is a fork of this process when that is safe (:func:`_fork_is_safe`): it starts with every module
+    this process imported (the jobs', to build their options), at no cost. Otherwise a fork server (spawn where
+    it is missing) starts the workers: it imports ``preload`` (the worker's and the jobs' modules) once, and
+    every worker it forks inherits them; :meth:`prestart` then starts them while the batch prepares its units.
+    """
+
+    def __init__(self, workers: int, preload: tuple[str, ...] = ()) -> None:
         self.workers = max(1, int(workers))
+        self.preload = tuple(preload)
         self._ex: cf.ProcessPoolExecutor | None = None
 
-    def __enter__(self) -> ProcessPool:
-        # forkserver (spawn where it is missing): a forked worker inherits a parent's OpenMP threads (numba's
-        # parallel kernels once they have run), which GNU OpenMP aborts on
-        method = "forkserver" if "forkserver" in mp.get_all_start_methods() else "spawn"
-        self._ex = cf.ProcessPoolExecutor(self.workers, mp_context=mp.get_context(method), initializer=_ignore_interrupt)
+    def prestart(self) -> ProcessPool:
+        """Start the workers ahead of the first unit where that helps: a fork server's, which import the jobs'
+        modules meanwhile (forked workers start with the first unit, with what this process imported by then)."""
+        if not _fork_is_safe():
+            self.start()
         return self
+
+    def start(self) -> ProcessPool:
+        """Start the workers (once); :meth:`close` stops them."""
+        if self._ex is not None:
+            return self
+        context: mp.context.BaseContext
+        if _fork_is_safe():
+            context = mp.get_context("fork")
+        else:
+            # forkserver (spawn where it is missing): a forked worker inherits a parent's OpenMP threads (numba's
+            # parallel kernels once they have run), which GNU OpenMP aborts on; the fork server runs no kernel
+            method = "forkserver" if "forkserver" in mp.get_all_start_methods() else "spawn"
+            context = mp.get_context(method)
+            if method == "forkserver" and self.preload:  # taken when this process starts its fork server (once)
+                context.set_forkserver_preload(["__main__", *self.preload])
+        self._ex = cf.ProcessPoolExecutor(self.workers, mp_context=context, initializer=_ignore_interrupt,
+                                          initargs=(self.preload,))
+        frozen = context.get_start_method() == "fork"
+        if frozen:  # the objects a forked worker inherits are left out of its garbage collections (no copy on write)
+            gc.freeze()
+        try:
+            for _ in range(self.workers):  # the workers started now (a fork server's: one per submission)
+                self._ex.submit(int)
+        finally:
+            if frozen:
+                gc.unfreeze()
+        return self
+
+    def __enter__(self) -> ProcessPool:
+        return self.start()
 
     def __exit__(self, *exc) -> None:
         self.close(cancel=exc[0] is not None)
@@ -59,11 +119,14 @@ class ProcessPool:
 
     def restart(self) -> None:
         """A new pool when the workers died (once: the other units the dead pool held fail the same way)."""
+        if self._ex is None:
+            self.start()
+            return
         try:
             self._ex.submit(int).cancel()
         except cf.BrokenExecutor:
             self.close(cancel=True)
-            self.__enter__()
+            self.start()
 
     def submit(self, fn, arg):
         return self._ex.submit(fn, arg)
@@ -82,7 +145,12 @@ class DaskPool:
 
     def __init__(self, address: str, workers: int | None = None) -> None:
         self.address, self.workers = address, workers
-        self._client = self._cluster = None
+        self._client: Any = None
+        self._cluster: Any = None
+
+    def prestart(self) -> DaskPool:
+        """Nothing before the first unit: a cluster is reached when the units run (:meth:`__enter__`)."""
+        return self
 
     def __enter__(self) -> DaskPool:
         try:
@@ -136,8 +204,9 @@ class DaskPool:
         return f"the Dask scheduler at {self.address}"
 
 
-def make_pool(workers: int, scheduler: str | None = None) -> ProcessPool | DaskPool:
-    """A process pool of ``workers``, or a Dask pool on ``scheduler`` (``"local"``: a local cluster of ``workers``)."""
+def make_pool(workers: int, scheduler: str | None = None, preload: tuple[str, ...] = ()) -> ProcessPool | DaskPool:
+    """A process pool of ``workers`` (``preload``: the modules its units need), or a Dask pool on ``scheduler``
+    (``"local"``: a local cluster of ``workers``)."""
     if scheduler is None:
-        return ProcessPool(workers)
+        return ProcessPool(workers, preload)
     return DaskPool(scheduler, workers)

@@ -29,6 +29,7 @@ import csv
 import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -170,7 +171,9 @@ def simulate_lot(folder: str | Path, n: int, spread: LotSpread = LotSpread(), se
         elif kinds[k] == "wrong direction":
             step = int(rng.integers(len(plan.steps)))
             steps = list(plan.steps)
-            steps[step] = dataclasses.replace(steps[step], rate=-steps[step].rate)
+            turn = steps[step].rate
+            assert turn is not None  # the lot's plan turns at rates
+            steps[step] = dataclasses.replace(steps[step], rate=-turn)
             run_plan = dataclasses.replace(plan, steps=tuple(steps))
         run = simulate_run(run_plan, model, session, rng)
         g = to_unit(run.g, "deg/s")
@@ -232,7 +235,7 @@ def read_truth(path: str | Path) -> tuple[dict, list[dict]]:
     if not first.startswith(f"# format={TRUTH_FORMAT} "):
         raise InputError(f"not a lot truth file (its first line is not '# format={TRUTH_FORMAT} ...')", str(path))
     head, _, units = first[2:].partition("; units: ")
-    meta = dict(item.split("=", 1) for item in head.split(";")[0].split() if "=" in item)
+    meta: dict[str, Any] = dict(item.split("=", 1) for item in head.split(";")[0].split() if "=" in item)
     meta["generator"] = head.split("generator=", 1)[1].split(";")[0]
     meta["convention"] = head.split("convention: ", 1)[1] if "convention: " in head else ""
     meta["units"] = {k.rstrip("*"): v for k, v in (u.split("=", 1) for u in units.split())}

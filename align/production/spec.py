@@ -86,13 +86,15 @@ class Limit:
         """``|phi_xy| <= 0.1 deg``, ``0.995 <= scale_x <= 1.005``, ``arw_x <= 0.3 deg/sqrt(h)``."""
         u = "" if self.unit == "1" else f" {self.unit}"
         name = f"{self.figure} - 1" if self.offset else self.figure
-        if self.symmetric:
-            return f"|{name}| <= {self.shown(self.high):g}{u}"
-        if self.low is not None and self.high is not None:
-            return f"{self.shown(self.low):g} <= {name} <= {self.shown(self.high):g}{u}"
-        if self.high is not None:
-            return f"{name} <= {self.shown(self.high):g}{u}"
-        return f"{name} >= {self.shown(self.low):g}{u}"
+        low, high = self.low, self.high
+        if self.symmetric and high is not None:
+            return f"|{name}| <= {self.shown(high):g}{u}"
+        if low is not None and high is not None:
+            return f"{self.shown(low):g} <= {name} <= {self.shown(high):g}{u}"
+        if high is not None:
+            return f"{name} <= {self.shown(high):g}{u}"
+        assert low is not None  # a limit has a bound (read_spec)
+        return f"{name} >= {self.shown(low):g}{u}"
 
 
 @dataclass(frozen=True)
@@ -198,9 +200,9 @@ def _limits(pattern: str, value, sensor: str | None, key: str, where: str) -> li
             raise InputError(f"{literal(key)}: its bounds are of different dimensions; write them in one unit", where)
         dim = dims.pop()
         unit = next(iter(bounds.values()))[1]
+        sensors: list[str]
         if figure in MAGNETOMETER_ONLY:
-            sensors = [sensor] if sensor in (None, "magnetometer") else []
-            sensors = ["magnetometer"] if sensor is None else sensors
+            sensors = ["magnetometer"] if sensor in (None, "magnetometer") else []
         elif sensor:
             sensors = [sensor]
         else:
@@ -211,6 +213,8 @@ def _limits(pattern: str, value, sensor: str | None, key: str, where: str) -> li
             raise InputError(f"{literal(key)}: '{literal(unit)}' is not a unit of {figure}"
                              + (f" for the {sensor}" if sensor else "")
                              + (f"; write it like {' or '.join(wanted)}" if wanted else ""), where)
+        low: float | None
+        high: float | None
         if "abs_max" in bounds:
             high = bounds["abs_max"][0]
             if high < 0:

@@ -213,7 +213,7 @@ def _group_unit(figure: str, sensor: str, reading_unit: str) -> str:
 
 
 def _violations(row: dict, spec: Spec | None) -> list[str]:
-    out = []
+    out: list[str] = []
     if spec is None:
         return out
     for lim in spec.limits:

@@ -28,6 +28,7 @@ import math
 from collections.abc import Iterable
 from datetime import UTC, datetime
 from pathlib import Path
+from typing import TextIO
 
 import pyarrow as pa
 import pyarrow.parquet as pq
@@ -52,7 +53,7 @@ def _column_unit(figure: str) -> str:
         return "SI of the sensor's readings (bias_unit)"
     units = {s: si_unit(figure, s) for s in ("gyroscope", "accelerometer")}
     if len(set(units.values())) == 1:
-        return units["gyroscope"]
+        return units["gyroscope"] or ""
     return ", ".join(f"{u} ({s})" for s, u in units.items())
 
 
@@ -97,7 +98,7 @@ def read_table(path: str | Path) -> pa.Table:
     """
     p = Path(path)
     if not p.exists():
-        return SCHEMA.empty_table()
+        return pa.Table.from_batches([], schema=SCHEMA)  # not SCHEMA.empty_table(): that imports pandas (0.5 s)
     if p.is_dir():
         raise InputError("is a folder; give the table's .parquet file", str(p))
     try:
@@ -179,7 +180,7 @@ class Journal:
     def __init__(self, table: str | Path) -> None:
         self.table = Path(table)
         self.path = self.table.with_name(self.table.name + ".journal")
-        self._fh = None
+        self._fh: TextIO | None = None
 
     def recover(self) -> int:
         """Fold a journal a killed run left into the table; the number of rows it held."""
@@ -190,10 +191,12 @@ class Journal:
         keeps them; not synced to the disk: a power cut may lose the last units, which a rerun then redoes)."""
         if self._fh is None:
             self._fh = open(self.path, "a", encoding="utf-8")
+            _warm()
+        fh = self._fh
         for r in rows:
-            self._fh.write(json.dumps({k: (v.isoformat() if isinstance(v, datetime) else v) for k, v in r.items()},
-                                      allow_nan=True) + "\n")
-        self._fh.flush()
+            fh.write(json.dumps({k: (v.isoformat() if isinstance(v, datetime) else v) for k, v in r.items()},
+                                allow_nan=True) + "\n")
+        fh.flush()
 
     def fold(self) -> int:
         """Move the journal's rows into the table (one atomic rewrite) and remove the journal."""
@@ -207,6 +210,12 @@ class Journal:
             n = append_rows(self.table, _fresh(old, _lines(fh)), old=old)
         self.path.unlink()
         return n
+
+
+def _warm() -> None:
+    """Make pyarrow ready to turn Python rows into a table now, while the workers compute, rather than in the
+    fold at the end: its first conversion imports pandas (a third of a second)."""
+    pa.array([0.0], type=pa.float64())
 
 
 def _key(row: dict) -> tuple:

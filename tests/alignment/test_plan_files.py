@@ -4,7 +4,7 @@ import json
 import math
 
 import pytest
-from conftest import ROOT, SHARED
+from support import ROOT, SHARED
 
 from align.alignment.plan import Plan, Step
 from align.alignment.segment import segments_from_ranges

@@ -127,7 +127,9 @@ def test_earth_rate_with_the_table_axis_up_east_or_north(table_axis, seed):
 
 
 def test_east_table_axis_was_the_failing_case_and_the_vertical_guess_would_miss():
-    """Before: the vertical rate was put along an east axis, biasing the bias by ~11 deg/h (6-13 sigma)."""
+    """Before: the vertical rate was put along an east axis, biasing the bias by ~11 deg/h (6-13 sigma). The wrong
+    plan's miss depends on how the fit weighs its segments: 4.4-4.6 deg/h here (4.7 sigma of the right plan; 5.1
+    before issue 23, when a false bias drift was read from the right plan's static periods)."""
     lat = 48.1 * DEG
     base = Plan.standard_rate(RATE)
     plan = Plan(tuple(Step(s.axis, s.sign, rate=s.rate, table_axis="east") for s in base.steps), latitude=lat,
@@ -138,7 +140,7 @@ def test_east_table_axis_was_the_failing_case_and_the_vertical_guess_would_miss(
     r = align(sess.t, sess.g, plan)
     wrong = align(sess.t, sess.g, Plan(base.steps, latitude=lat))  # the table axis left at "up"
     assert np.abs(r.bias - model.bias).max() < 3 * r.sigma_bias.max()
-    assert np.abs(wrong.bias - model.bias).max() > 5 * r.sigma_bias.max()
+    assert np.abs(wrong.bias - model.bias).max() > 4 * r.sigma_bias.max()
 
 
 @pytest.mark.parametrize("seed", SEEDS)
@@ -224,11 +226,12 @@ def test_step_missing_from_the_log_is_named():
     assert "\n" not in str(err.value)
 
 
+@pytest.mark.slow
 def test_the_reoriented_example_is_found_and_covered(run_cli, tmp_path):
     """examples/alignment/reoriented: mounting detected, moves left out, east table axis, ms time, drifting bias."""
     import json
 
-    from conftest import ROOT
+    from support import ROOT
 
     here = ROOT / "examples/alignment/reoriented"
     out = tmp_path / "out.json"

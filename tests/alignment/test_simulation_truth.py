@@ -23,7 +23,7 @@ def test_truth_round_trips_and_the_random_model_has_the_size_asked(tmp_path):
 
 
 def test_bundled_truth_of_version_0_1_still_loads():
-    from conftest import ROOT
+    from support import ROOT
 
     truth = load_result(ROOT / "examples/alignment/truth.json")
     assert isinstance(truth, SimulationTruth) and truth.seed == 7

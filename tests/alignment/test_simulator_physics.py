@@ -147,6 +147,7 @@ def test_latitude_comes_from_the_plan_and_a_disagreeing_spec_is_refused():
     assert np.array_equal(t, run.t) and np.array_equal(g, run.g) and np.array_equal(w, run.w)
 
 
+@pytest.mark.slow
 def test_flicker_gives_the_allan_floor_of_its_coefficient():
     from align.noise.allan import allan
 

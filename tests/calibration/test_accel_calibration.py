@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 from accelsim import six_faces
-from conftest import SHARED
+from support import SHARED
 
 from align.calibration import accel_session, calibrate_accel
 from align.errors import InputError, TestError

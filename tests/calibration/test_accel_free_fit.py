@@ -33,6 +33,7 @@ def _z(cal, t_a, b_a) -> np.ndarray:
 
 
 @pytest.mark.parametrize("poses", [10, 20])
+@pytest.mark.slow
 def test_every_element_inside_3_sigma_at_the_normal_rate(poses):
     """Over 150 sessions, M's six free elements and the bias inside 3 sigma for >= 99 % of the elements (99.73 %
     expected). Before the t-widening and the full covariance: 76 % at 10 poses (1 degree of freedom, wrong minima
@@ -46,6 +47,7 @@ def test_every_element_inside_3_sigma_at_the_normal_rate(poses):
         assert 0.65 < rms < 1.1, rms
 
 
+@pytest.mark.slow
 def test_the_stated_sigma_is_the_spread_of_repeated_sessions_and_says_how_it_was_widened():
     """One sensor, one set of attitudes, 300 noise draws: the Jacobian's 1-sigma (the stated one over its widening)
     is the spread of the estimates, element by element (M from the full covariance of U, correlations included)."""
@@ -71,6 +73,7 @@ def _cost(m, b, means):
     return float(np.sum((np.linalg.norm((means - b) @ np.linalg.inv(m).T, axis=1) - G) ** 2))
 
 
+@pytest.mark.slow
 def test_the_fit_reaches_the_least_squares_minimum_on_attitudes_clustered_on_one_side():
     """Ten attitudes within 80 deg of one direction: the least-squares cost of the fit is never above the cost at
     the truth (a local minimum would be). The single start from the means' centre ended above it in 19 of 200."""

@@ -10,8 +10,8 @@ import numpy as np
 import pandas as pd
 import pytest
 from accelsim import attitudes, six_faces
-from conftest import SHARED
 from magsim import F, capture, truth
+from support import SHARED
 
 from align.calibration import (
     Calibration,

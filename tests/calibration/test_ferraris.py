@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pandas as pd
 import pytest
-from conftest import SHARED
+from support import SHARED
 
 from align.calibration import Calibration, ferraris
 from align.units import DEG
@@ -34,12 +34,13 @@ def test_ferraris_session_against_imucal():
     assert np.allclose(a.bias, info.b_a, atol=1e-12)
     # gyro: the same g-sensitivity; the bias estimators differ (imucal pools the raw face samples, we weight the
     # faces' means after removing K_ga a), and that difference alone explains the matrix difference:
-    # M_ours - M_imucal = (b_imucal - b_ours) T_rot / theta, column by column (Eq 31)
+    # M_ours - M_imucal = (b_imucal - b_ours) T_rot / theta, column by column (Eq 31); to 1e-7 (0.003 sigma), not
+    # exactly: without a latitude the fit also weighs the Earth rate a face and the turn after it share (issue 23)
     assert np.allclose(g.g_sensitivity / DEG, info.K_ga, atol=1e-12)
     db = info.b_g - g.bias / DEG
     t_rot = np.array([sections[f"{x}_rot"][1] - sections[f"{x}_rot"][0] for x in "xyz"]) / 102.4
     explained = np.outer(db, t_rot) / -360.0
-    assert np.allclose(g.M - info.K_g @ info.R_g, explained, atol=1e-12)
+    assert np.allclose(g.M - info.K_g @ info.R_g, explained, atol=3e-7)
     assert 1e-7 < np.abs(g.M - info.K_g @ info.R_g).max() < 1e-4
 
 

@@ -26,6 +26,7 @@ def _session(seed, k_ga=None, **spec):
     return run, t_acc, g_acc, q
 
 
+@pytest.mark.slow
 def test_the_simulated_attitude_is_the_integral_of_the_simulated_rates():
     run, *_ = _session(1, fs=200.0, poses=4)
     c = quat_to_matrix(integrate(run.rates, np.diff(run.t)))
@@ -44,6 +45,7 @@ def test_truth_in_the_accelerometer_frame_is_upper_triangular_and_the_same_physi
     assert np.allclose(t_acc @ q, m_a) and np.allclose(g_acc @ q, m_g)
 
 
+@pytest.mark.slow
 def test_gyro_m_within_its_3_sigma_over_24_seeds():
     """All nine elements of M inside 3 sigma in at least 23 of 24 sessions (normal: ~97.6 % for nine), and the
     1-sigma not padded: the normalised errors have an rms near 1."""
@@ -60,6 +62,7 @@ def test_gyro_m_within_its_3_sigma_over_24_seeds():
     assert 0.6 < rms < 1.3, rms  # about 0.8: the propagated direction errors are partly in the residuals too
 
 
+@pytest.mark.slow
 def test_the_residual_table_and_notes():
     run, _, g_acc, _ = _session(3)
     s = calibrate_gyro_session(run.t, run.acc, run.gyr, "m/s^2", "rad/s")
@@ -76,6 +79,7 @@ def test_the_residual_table_and_notes():
     assert "observability: condition number" in notes and s.weak_column is None
 
 
+@pytest.mark.slow
 def test_a_sequence_that_hardly_turns_about_z_flags_column_3_and_still_covers_the_truth():
     flagged = 0
     for seed in range(6):
@@ -89,12 +93,14 @@ def test_a_sequence_that_hardly_turns_about_z_flags_column_3_and_still_covers_th
     assert "column 3 (z) of M is weakly determined" in " ".join(s.gyroscope.notes)
 
 
+@pytest.mark.slow
 def test_a_sequence_that_never_turns_about_z_is_refused():
     run, *_ = _session(4, axes="xy", wobble=0.0)
     with pytest.raises(TestError, match=r"do not span 3-D: column 3 \(z\) of M is not determined"):
         calibrate_gyro_session(run.t, run.acc, run.gyr, "m/s^2", "rad/s")
 
 
+@pytest.mark.slow
 def test_g_sensitivity_recovered_and_m_still_covered():
     rng = np.random.default_rng(99)
     k_true = rng.normal(0, 3e-4, (3, 3))  # (rad/s) per (m/s^2): 0.17 deg/s per g
@@ -107,6 +113,7 @@ def test_g_sensitivity_recovered_and_m_still_covered():
         assert np.abs(got.M - g_acc).max() < np.abs(plain.M - g_acc).max()  # the model the data need does better
 
 
+@pytest.mark.slow
 def test_counts_give_m_in_counts_per_rad_s():
     run, _, g_acc, _ = _session(5)
     lsb = 131.0 / DEG  # counts per rad/s, an MPU-6050 at +/-250 deg/s

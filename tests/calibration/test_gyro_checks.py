@@ -60,6 +60,7 @@ def test_malformed_intervals():
         parse_intervals("0:10,5:20", 100)
 
 
+@pytest.mark.slow
 def test_a_clipped_rotation_is_refused_by_name_and_can_be_left_out():
     run = _run(2)
     raw = np.round(run.gyr * LSB + 40.0)
@@ -99,6 +100,7 @@ def test_a_record_that_starts_moving_is_refused():
     assert "does not start at rest" in _one_line(exc) and "init_static_s" in str(exc.value)
 
 
+@pytest.mark.slow
 def test_a_unit_mix_up_is_refused():
     run = _run(4)
     with pytest.raises(TestError, match="scale factor .* is outside 1 \\+/- 0.2: wrong {gyro_units}|outside 1"):

@@ -5,7 +5,7 @@ import json
 
 import numpy as np
 import pytest
-from conftest import SHARED
+from support import SHARED
 
 XSENS = SHARED / "data" / "multiposition" / "xsens_mti_imu_tk"
 MPU = SHARED / "data" / "multiposition" / "mpu6050_tomisuarez2"
@@ -22,6 +22,7 @@ MPU_ARGS = ("calibrate", "gyro", MPU / "example_data_calibration.csv", "--skip-r
 
 @pytest.mark.parametrize("g_sensitivity, within, rms_deg", [("--no-g-sensitivity", 0.01, 1.0),
                                                              ("--g-sensitivity", 0.003, 0.2)])
+@pytest.mark.slow
 def test_xsens_gyro_scales_against_the_datasheet(run_cli, tmp_path, g_sensitivity, within, rms_deg):
     out = tmp_path / "xsens.json"
     res = run_cli(*XSENS_ARGS, g_sensitivity, "--json", out)

@@ -49,6 +49,7 @@ def coverage_run(kind: str, seeds: int = SEEDS):
 
 
 @pytest.mark.parametrize("kind", ["sphere", "hemisphere"])
+@pytest.mark.slow
 def test_hard_and_soft_iron_inside_their_3_sigma(kind):
     zh, zw, refused = coverage_run(kind)
     assert refused <= 0.05 * SEEDS, f"the gates refused {refused} of {SEEDS} {kind} captures"
@@ -71,6 +72,7 @@ def hand_held(truth, rng, n, max_tilt_deg, noise=0.5e-6):
     return truth.readings(yaw * tilt, rng, noise)[0]
 
 
+@pytest.mark.slow
 def test_tilted_captures_accepted_only_with_an_honest_sigma():
     """Hand-held captures tilted at most 45 deg: the gates accept some (the hard iron then known to
     < 2 % of the field); those they accept are covered like full ones. At most 20 deg: all refused."""

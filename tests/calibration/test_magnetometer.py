@@ -4,9 +4,9 @@ import json
 
 import numpy as np
 import pytest
-from conftest import SHARED
 from magsim import F, capture, truth
 from scipy.spatial.transform import Rotation
+from support import SHARED
 
 from align.calibration import MagCalibration, calibrate_magnetometer, with_gravity_alignment
 from align.errors import InputError, TestError

@@ -31,7 +31,7 @@ from pathlib import Path
 import pytest
 from campaign_cases import CASES, PYTHON_REPRS, Case
 from campaign_inputs import build_inputs
-from conftest import imu_align_command
+from support import imu_align_command
 
 #: seconds one in-process case may take before it is reported as hanging
 CASE_TIMEOUT = 60
@@ -200,7 +200,9 @@ def check_case(case: Case, folder: CaseFolder, before: set[str], code: int, err:
     return problems
 
 
-@pytest.mark.parametrize("case", CASES, ids=[c.id for c in CASES])
+# the borderline inputs (full runs that must work) and the real processes but one are the slow lane's
+@pytest.mark.parametrize("case", [pytest.param(c, marks=pytest.mark.slow) if c.kind == "borderline" or (
+    c.process and c.command != "top") else c for c in CASES], ids=[c.id for c in CASES])
 def test_bad_input(case: Case, campaign_inputs, tmp_path, capsys, monkeypatch):
     monkeypatch.delenv("IMU_ALIGN_DEBUG", raising=False)
     root = tmp_path / "case"

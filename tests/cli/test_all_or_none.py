@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import ROOT, SHARED, truth_model, write_session
+from support import ROOT, SHARED, truth_model, write_session
 
 from align.errors import InputError
 from align.io.outputs import Outputs
@@ -136,6 +136,7 @@ def test_ferraris_json_then_a_failing_imucal_json(tmp_path, run_cli, monkeypatch
                            "--json", out / "cal.json", "--imucal-json", out / "imucal.json")
 
 
+@pytest.mark.slow
 def test_demo_whose_report_fails_leaves_no_file_and_no_folder(tmp_path, run_cli, monkeypatch):
     import align.present.html
 
@@ -144,6 +145,7 @@ def test_demo_whose_report_fails_leaves_no_file_and_no_folder(tmp_path, run_cli,
     assert list(tmp_path.iterdir()) == []  # the folders it would have created are gone too
 
 
+@pytest.mark.slow
 def test_demo_into_an_existing_folder_keeps_the_old_files_on_a_failure(tmp_path, run_cli, monkeypatch):
     import align.present.html
 

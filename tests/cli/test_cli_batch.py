@@ -54,6 +54,7 @@ def _static_gyro(folder, arw, fs=100.0, seconds=300.0, seed=2):
               np.column_stack([np.arange(n) / fs, g / DEG]))
 
 
+@pytest.mark.slow
 def test_every_job_of_a_mixed_manifest_gives_its_figures_against_truth(tmp_path, run_cli):
     lot = simulate_lot(tmp_path / "lot", 2, session=SHORT, bad=0, seed=5)
     m_acc, b_acc = np.diag([1.01, 0.99, 1.0]) + 0.003, np.array([0.1, -0.2, 0.05])
@@ -143,6 +144,7 @@ def small_lot(tmp_path):
     return lot, spec
 
 
+@pytest.mark.slow
 def test_exit_status_and_summary_say_how_many_units_failed(small_lot, tmp_path, run_cli):
     lot, spec = small_lot
     out = tmp_path / "out"
@@ -168,6 +170,7 @@ def test_exit_status_and_summary_say_how_many_units_failed(small_lot, tmp_path, 
     assert len(t) == 9 and t.run.nunique() == 2 and str(t.time.dt.tz) == "UTC"
 
 
+@pytest.mark.slow
 def test_a_changed_input_or_option_runs_that_unit_again(small_lot, tmp_path, run_cli):
     lot, _ = small_lot
     out = tmp_path / "out"
@@ -214,6 +217,7 @@ def test_a_bad_manifest_is_one_line_naming_row_and_column(tmp_path, run_cli, tex
     assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
 
 
+@pytest.mark.slow
 def test_scheduler_errors_are_one_line(small_lot, tmp_path, run_cli, monkeypatch):
     lot, _ = small_lot
     res = run_cli("batch", lot.manifest, "--scheduler", "tcp://127.0.0.1:8786", "--workers", 2)
@@ -231,6 +235,7 @@ def test_scheduler_errors_are_one_line(small_lot, tmp_path, run_cli, monkeypatch
                                          "pip install 'imu-align[cluster]'\n")
 
 
+@pytest.mark.slow
 def test_lot_without_a_spec_describes_the_key_figures_and_passes(small_lot, tmp_path, run_cli):
     lot, _ = small_lot
     run_cli("batch", lot.manifest, "--out", tmp_path / "out")
@@ -241,6 +246,7 @@ def test_lot_without_a_spec_describes_the_key_figures_and_passes(small_lot, tmp_
     assert res.code == 2 and "nowhere.parquet: file not found" in res.err
 
 
+@pytest.mark.slow
 def test_a_progress_bar_over_units_on_a_terminal_only(small_lot, tmp_path, run_cli, monkeypatch):
     import io
 
@@ -257,16 +263,17 @@ def test_a_progress_bar_over_units_on_a_terminal_only(small_lot, tmp_path, run_c
     assert "imu-align: error: batch: 1 of 8 units failed" in drawn  # the summary line after the bar
 
 
+@pytest.mark.slow
 def test_units_run_in_threads_at_once_keep_their_own_messages(small_lot, tmp_path, monkeypatch):
-    """A Dask worker may run several units in threads of one process: each unit's output is its own."""
+    """A Dask worker may run several units in threads of one process: each unit's result and message is its own,
+    and the worker touches no stream of the process."""
     from concurrent.futures import ThreadPoolExecutor
 
     from align.cli.batch import _jobs, _task_maker, run_unit
     from align.production import read_manifest
 
     lot, _ = small_lot
-    monkeypatch.setattr(sys, "stdout", sys.stdout)  # run_unit routes this process's streams: put them back after
-    monkeypatch.setattr(sys, "stderr", sys.stderr)
+    streams = sys.stdout, sys.stderr
     units = read_manifest(lot.manifest, _jobs()).units
     make = _task_maker(lot.folder.resolve())
     (tmp_path / "units").mkdir()
@@ -281,8 +288,10 @@ def test_units_run_in_threads_at_once_keep_their_own_messages(small_lot, tmp_pat
             assert row["status"] == "failed" and f"{wrong}.csv: step" in row["message"]
         else:
             assert row["status"] == "ok" and row["message"] == ""
+    assert (sys.stdout, sys.stderr) == streams
 
 
+@pytest.mark.slow
 def test_ctrl_c_keeps_the_units_done_and_says_so(small_lot, tmp_path, run_cli, monkeypatch):
     import contextlib
 

@@ -9,7 +9,7 @@ import subprocess
 import time
 
 import pyarrow.parquet as pq
-from conftest import imu_align_command
+from support import imu_align_command
 
 from align.alignment.simulate import SessionSpec
 from align.production import simulate_lot

@@ -19,15 +19,29 @@ def lot3(tmp_path):
     return simulate_lot(tmp_path / "lot", 3, session=SessionSpec(fs=200.0, dwell_s=2.0, static_s=1.0), bad=0, seed=3)
 
 
+def _static_record(folder):
+    """A static gyro record (white noise at rest, deg/s) for the allan job: a rate-table session is no noise record."""
+    import numpy as np
+
+    from align.io import write_csv
+
+    rng = np.random.default_rng(4)
+    n, fs = 6000, 100.0
+    write_csv(folder / "static.csv", ["time", "gyro_x", "gyro_y", "gyro_z"],
+              np.column_stack([np.arange(n) / fs, rng.normal(0, 0.05, (n, 3))]))
+
+
 def _manifest(path, *rows):
     path.write_text("serial,job,log,plan,options\n" + "".join(r + "\n" for r in rows))
     return path
 
 
+@pytest.mark.slow
 def test_one_serial_with_two_jobs_keeps_a_result_per_job_and_is_one_unit(lot3, tmp_path, run_cli):
     folder = lot3.folder
+    _static_record(folder)
     both = _manifest(folder / "both.csv", "SN0001,matrix,sessions/SN0001.csv,plan.toml,",
-                     "SN0001,allan,sessions/SN0001.csv,,", "SN0002,matrix,sessions/SN0002.csv,plan.toml,")
+                     "SN0001,allan,static.csv,,", "SN0002,matrix,sessions/SN0002.csv,plan.toml,")
     out = tmp_path / "out"
     res = run_cli("batch", both, "--out", out, "--workers", 1)
     assert res.code == 0, res.err
@@ -40,7 +54,7 @@ def test_one_serial_with_two_jobs_keeps_a_result_per_job_and_is_one_unit(lot3, t
     assert res.code == 0 and "lot of" in res.out and ": 2 units" in res.out, res.out
     # the review's sequence: matrix, then allan, then matrix again from separate manifests of the same serial
     a = _manifest(folder / "a.csv", "SN0001,matrix,sessions/SN0001.csv,plan.toml,")
-    b = _manifest(folder / "b.csv", "SN0001,allan,sessions/SN0001.csv,,")
+    b = _manifest(folder / "b.csv", "SN0001,allan,static.csv,,")
     assert "ran 0, skipped 1" in run_cli("batch", a, "--out", out).out
     assert "ran 0, skipped 1" in run_cli("batch", b, "--out", out).out
     assert type(load_result(out / "units" / "SN0001.matrix.json")).FORMAT == "imu-align.alignment"
@@ -66,6 +80,8 @@ def test_the_same_serial_and_job_twice_is_refused(lot3):
     ("--json x.json", "--json is the batch's own"),
     ("extra.csv", "'extra.csv' is not an option of matrix"),
     ("--margin", "--margin needs a value"),
+    ("--margin abc", "line 2, column options: invalid value for --margin: 'abc' does not start with a number"),
+    ("--method best", "line 2, column options: invalid value for --method"),
 ])
 def test_options_are_checked_against_the_command_when_the_manifest_is_read(lot3, tmp_path, run_cli, options, words):
     m = _manifest(lot3.folder / "o.csv", f'SN0001,matrix,sessions/SN0001.csv,plan.toml,"{options}"',
@@ -90,8 +106,9 @@ def test_axis_down_files_resolve_against_the_manifest_and_enter_the_hash(tmp_pat
     check_options(unit, str(m))
     make = _task_maker(data.resolve())
     task = make(unit, tmp_path / "out" / unit.result_name, "r")
-    given = task.args[task.args.index("--axis-down") + 1]
-    assert given == f"x={(data / 'xd.csv').resolve()},y={(data / 'yd.csv').resolve()},z=100:900"
+    assert task.refused is None  # the job's options, built in this process
+    assert dict(task.options.axis_down) == {"x": (data / "xd.csv").resolve(), "y": (data / "yd.csv").resolve(),
+                                            "z": (100, 900)}
     assert (data / "xd.csv").resolve() in task.inputs and (data / "yd.csv").resolve() in task.inputs
     before = task.digest()
     (data / "xd.csv").write_text("time,mag_x,mag_y,mag_z\n0,1,2,4\n")  # the capture edited: the unit reruns
@@ -115,3 +132,22 @@ def test_a_foreign_parquet_and_a_bad_scheduler_are_one_line(lot3, tmp_path, run_
     res = run_cli("batch", lot3.manifest, "--out", tmp_path / "o2", "--scheduler", "bogus")
     assert res.code == 2 and res.err.count("\n") == 1 and "'bogus' is not a Dask scheduler address" in res.err, res.err
     assert "internal error" not in res.err and not (tmp_path / "o2").exists()
+
+
+def test_old_spellings_of_options_are_taken_as_the_command_takes_them(tmp_path):
+    """``calibrate ferraris --acc-units`` (today --accel-units) in a manifest: the unit's options are the single
+    command's."""
+    from align.cli.batch import _jobs, _task_maker, check_options
+    from align.cli.options import ALIASES
+
+    old, new = next(iter(ALIASES["calibrate ferraris"].items()))
+    assert (old, new) == ("--acc-units", "--accel-units")
+    (tmp_path / "s.json").write_text("{}")
+    rows = [f'F1,calibrate ferraris,f.csv,s.json,"--rate-hz 100 {flag} g"' for flag in (old, new)]
+    tasks = []
+    for k, row in enumerate(rows):
+        m = _manifest(tmp_path / f"m{k}.csv", row)
+        unit = read_manifest(m, _jobs()).units[0]
+        check_options(unit, str(m))
+        tasks.append(_task_maker(tmp_path.resolve())(unit, tmp_path / "out" / unit.result_name, "r"))
+    assert tasks[0].refused is None and tasks[0].options == tasks[1].options

@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 import pytest
 import yaml
-from conftest import ROOT, SHARED
+from support import ROOT, SHARED
 
 from align.calibration import Calibration, CalibrationSet, MagCalibration
 from align.noise.sim import NoiseSpec, simulate_noise

@@ -8,8 +8,8 @@ import re
 import numpy as np
 import pandas as pd
 import pytest
-from conftest import ROOT, SHARED
 from scipy.spatial.transform import Rotation
+from support import ROOT, SHARED
 
 from align.calibration import Calibration, CalibrationSet
 from align.present.angles import angle_rows, number

@@ -5,7 +5,7 @@ import json
 import re
 
 import numpy as np
-from conftest import SHARED
+from support import SHARED
 
 from align.calibration import Calibration, CalibrationSet
 from align.present.text import calibration_summary

@@ -49,6 +49,7 @@ def test_old_spellings_are_hidden_but_today_s_are_shown(run_cli, command):
         assert not re.search(rf"(?<![\w-]){re.escape(old)}(?![\w-])", out), (command, old)
 
 
+@pytest.mark.slow
 def test_one_spelling_per_concept():
     """No command offers a retired spelling; units, columns and the sample rate are spelled one way."""
     retired = {"--gyr-units", "--acc-units", "--allan-units", "--gyr-columns", "--acc-columns", "--allan-columns",

@@ -13,7 +13,7 @@ import json
 
 import numpy as np
 import pytest
-from conftest import ROOT, SHARED
+from support import ROOT, SHARED
 
 MPU = SHARED / "data" / "static" / "mpu6050_tomisuarez2" / "imu_static_test.csv"
 MPU_MULTI = SHARED / "data" / "multiposition" / "mpu6050_tomisuarez2"
@@ -249,6 +249,7 @@ def test_calibrate_mag_with_semicolons_and_a_preamble(run_cli, tmp_path):
     assert a["hard_iron"] == b["hard_iron"] and b["inputs"]["delimiter"] == ";" and b["inputs"]["skip_rows"] == 2
 
 
+@pytest.mark.slow
 def test_report_reads_a_logger_file_with_its_options(tmp_path, run_cli):
     """The report's rate-table log goes through the same reader options as matrix (issue 12)."""
     src = ROOT / "examples/alignment"

@@ -38,8 +38,8 @@ def test_library_errors_render_with_flags():
 
 
 def test_aliases_are_rewritten_per_command():
-    assert rewrite_aliases("simulate", ["out", "--fs", "100 Hz"]) == ["out", "--rate-hz", "100 Hz"]
-    assert rewrite_aliases("simulate", ["out", "--fs=100"]) == ["out", "--rate-hz=100"]
+    assert rewrite_aliases("simulate session", ["out", "--fs", "100 Hz"]) == ["out", "--rate-hz", "100 Hz"]
+    assert rewrite_aliases("simulate session", ["out", "--fs=100"]) == ["out", "--rate-hz=100"]
     assert rewrite_aliases("matrix", ["log", "--fs", "100"]) == ["log", "--fs", "100"]  # not an option of matrix
     assert rewrite_aliases("calibrate accel", ["x", "--units", "counts", "--", "--units"]) == \
         ["x", "--accel-units", "counts", "--", "--units"]

@@ -4,7 +4,7 @@ import json
 import math
 
 import pytest
-from conftest import ROOT
+from support import ROOT
 
 from align.parts import PARTS
 

@@ -4,7 +4,7 @@ import json
 
 import numpy as np
 import pytest
-from conftest import ROOT, truth_model, write_session
+from support import ROOT, truth_model, write_session
 
 from align.alignment.plan import Plan
 from align.alignment.simulate import SessionSpec, simulate_session

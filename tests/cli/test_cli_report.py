@@ -10,8 +10,8 @@ import shutil
 
 import numpy as np
 import pytest
-from conftest import ROOT, SHARED, in_chromium, write_session
 from scipy.spatial.transform import Rotation
+from support import ROOT, SHARED, in_chromium, write_session
 
 from align.alignment.plan import Plan
 from align.alignment.simulate import SessionSpec, simulate_session
@@ -56,6 +56,7 @@ browser = pytest.mark.skipif(shutil.which("chromium") is None, reason="Chromium 
 
 
 @browser
+@pytest.mark.slow
 def test_report_of_a_rate_table_log_alone_renders(tmp_path, run_cli):
     _, log, plan = session(tmp_path)
     out = tmp_path / "report.html"
@@ -77,6 +78,7 @@ def test_report_of_a_rate_table_log_alone_renders(tmp_path, run_cli):
 
 
 @browser
+@pytest.mark.slow
 def test_report_of_calibrations_alone_renders(tmp_path, run_cli):
     mag, fer = tmp_path / "mag.json", tmp_path / "ferraris.json"
     assert run_cli("calibrate", "mag", MAG, "--columns", "mag_x_gauss,mag_y_gauss,mag_z_gauss", "--mag-units", "gauss",
@@ -100,6 +102,7 @@ def test_report_of_calibrations_alone_renders(tmp_path, run_cli):
     assert f"largest residual {worst:.3g} deg/s" in page
 
 
+@pytest.mark.slow
 def test_measured_misalignment_over_the_allowance_fails_at_the_top_and_exits_4(tmp_path, run_cli):
     truth, log, plan = session(tmp_path)
     man = tmp_path / "tight.toml"
@@ -190,6 +193,7 @@ def test_report_input_errors(tmp_path, run_cli):
     assert res.code == 2 and "imu-align.calibration" in res.err and not out.exists()
 
 
+@pytest.mark.slow
 def test_apply_plot_and_all_or_none(tmp_path, run_cli, monkeypatch):
     _, log, plan = session(tmp_path)
     aj = tmp_path / "a.json"
@@ -212,6 +216,7 @@ def test_apply_plot_and_all_or_none(tmp_path, run_cli, monkeypatch):
     assert not png2.exists() and not csv2.exists()  # all or none: the CSV is not written without its picture
 
 
+@pytest.mark.slow
 def test_drift_section_and_its_number(tmp_path, run_cli):
     """Issue 16's error growth (align.present.navigation) in the report: its section before the inputs, its picture,
     and the summary's number the drift result's own (horizontal position 1-sigma at the end)."""

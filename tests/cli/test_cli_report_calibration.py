@@ -8,7 +8,7 @@ import re
 
 import numpy as np
 import pytest
-from conftest import SHARED
+from support import SHARED
 
 MPU = SHARED / "data" / "multiposition" / "mpu6050_tomisuarez2" / "example_data_calibration.csv"
 FERRARIS = SHARED / "data" / "multiposition" / "imucal_ferraris"
@@ -23,6 +23,7 @@ def _table_after(page: str, marker: str) -> np.ndarray:
     return np.array([[float(html.unescape(c).split("±")[0]) for c in row] for row in cells])
 
 
+@pytest.mark.slow
 def test_counts_calibration_states_its_unit_and_significant_digits(tmp_path, run_cli):
     cal, out = tmp_path / "acc.json", tmp_path / "r.html"
     assert run_cli("calibrate", "accel", MPU, "--columns", "ax,ay,az", "--accel-units", "counts", "--rate-hz", "100",
@@ -57,6 +58,7 @@ def test_g_sensitivity_in_the_unit_the_file_and_terminal_give(tmp_path, run_cli)
     assert np.allclose(_table_after(page, "g-sensitivity K_ga"), np.array(g["g_sensitivity"]), rtol=1e-3)
 
 
+@pytest.mark.slow
 def test_a_magnetometer_report_states_its_own_convention(tmp_path, run_cli):
     mag, out = tmp_path / "mag.json", tmp_path / "r.html"
     assert run_cli("calibrate", "mag", MAG, "--columns", "mag_x_gauss,mag_y_gauss,mag_z_gauss", "--mag-units", "gauss",
@@ -69,6 +71,7 @@ def test_a_magnetometer_report_states_its_own_convention(tmp_path, run_cli):
 
 
 @pytest.mark.parametrize("title", [None, "My own title"])
+@pytest.mark.slow
 def test_title_default_and_given(tmp_path, run_cli, title):
     mag = tmp_path / "mag.json"
     assert run_cli("calibrate", "mag", MAG, "--columns", "mag_x_gauss,mag_y_gauss,mag_z_gauss", "--mag-units", "gauss",

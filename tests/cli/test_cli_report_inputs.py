@@ -8,8 +8,8 @@ import re
 
 import numpy as np
 import pytest
-from conftest import ROOT, write_session
 from scipy.spatial.transform import Rotation
+from support import ROOT, write_session
 
 from align.alignment.plan import Plan
 from align.alignment.simulate import SessionSpec, simulate_session
@@ -44,6 +44,7 @@ def _x_error(d):
     return worst
 
 
+@pytest.mark.slow
 def test_the_reviewers_unit_fails_the_manoeuvre_and_exits_4(tmp_path, run_cli):
     """phi_xy 0.085 deg and phi_xz 0.095 deg, each within its allowance alone, give the x gyro 0.170 deg over a
     0.1 deg limit."""
@@ -64,6 +65,7 @@ def test_the_reviewers_unit_fails_the_manoeuvre_and_exits_4(tmp_path, run_cli):
         assert re.search(rf'<td class="l">{element}</td>(<td class="">[^<]*</td>){{5}}<td class="pass">PASS', page)
 
 
+@pytest.mark.slow
 def test_within_the_guard_band_is_warn_and_counted(tmp_path, run_cli):
     """A limit equal to the unit's own error (computed here by scipy): margin 0, inside +-2 sigma: WARN, exit 0."""
     log, plan = session(tmp_path, matrix_from_angles({"phi_xy": 0.04 * DEG, "phi_xz": 0.03 * DEG}))
@@ -78,6 +80,7 @@ def test_within_the_guard_band_is_warn_and_counted(tmp_path, run_cli):
     assert "Guard band k = 2" in page
 
 
+@pytest.mark.slow
 def test_a_failed_budget_is_a_design_check_when_the_unit_is_measured(tmp_path, run_cli):
     """Example 1's mount (1.3 deg) fails a 1/6 deg manoeuvre; a unit measured within it passes: exit 0, the budget
     labelled a design check. Without the measurement the budget governs: exit 4."""
@@ -120,6 +123,7 @@ def test_out_may_not_be_the_capture_or_recording_a_result_names(tmp_path, run_cl
     assert res.code == 2 and "is a data file al.json names" in res.err and static.read_bytes() == before
 
 
+@pytest.mark.slow
 def test_redrawn_as_recorded_and_found_beside_the_result(tmp_path, run_cli, monkeypatch):
     """A log read with a preamble and ';' (matrix --skip-rows 2 --delimiter ';', run in its own folder with relative
     paths): the report from another folder draws it again with no format option; a wrong option given says why in
@@ -145,6 +149,7 @@ def test_redrawn_as_recorded_and_found_beside_the_result(tmp_path, run_cli, monk
     assert "give comment = #" in (tmp_path / "r2.html").read_text()
 
 
+@pytest.mark.slow
 def test_a_log_with_its_own_column_names_and_no_time(tmp_path, run_cli):
     log, plan = session(tmp_path)
     rows = np.loadtxt(log, delimiter=",", skiprows=1)
@@ -165,6 +170,7 @@ def test_a_log_with_its_own_column_names_and_no_time(tmp_path, run_cli):
     assert res.code == 0 and res.out.splitlines()[0] == base
 
 
+@pytest.mark.slow
 def test_the_parts_file_is_read_only_when_a_part_is_looked_up(tmp_path, run_cli, monkeypatch):
     bad = tmp_path / "bad.toml"
     bad.write_text("[X]\nnot_a_field = 1\n")

@@ -195,7 +195,7 @@ def _library_fields() -> set[str]:
     import ast
     import re
 
-    from conftest import ROOT
+    from support import ROOT
 
     found = set()
     pattern = re.compile(r"(?<!\{)\{([a-z][a-z0-9_]*)(?:=[^{}]*)?\}(?!\})")
@@ -208,6 +208,7 @@ def _library_fields() -> set[str]:
     return found
 
 
+@pytest.mark.slow
 def test_every_library_field_renders_as_an_option_of_the_command_or_in_words():
     """No message names an option the command does not have (``--units`` for ``--gyro-units``, ``--min-dwell``
     in ``ferraris``): each placeholder is spelled as one of the command's own options, or in plain words."""

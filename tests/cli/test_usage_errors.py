@@ -9,7 +9,7 @@ import subprocess
 import sys
 
 import pytest
-from conftest import imu_align_command
+from support import imu_align_command, slow_beyond
 
 MODULE = [sys.executable, "-m", "align.cli"]
 
@@ -27,7 +27,7 @@ def one_line(res, code=2):
     return lines[0]
 
 
-@pytest.mark.parametrize("args,words", [
+@pytest.mark.parametrize("args,words", slow_beyond(3, [  # a process each: the first three in the fast lane
     ((), ["imu-align: missing command", "usage: imu-align COMMAND", "matrix", "see imu-align --help"]),
     (("matrix",), ["imu-align matrix: missing argument LOG",
                    "usage: imu-align matrix LOG --plan PLAN.toml [options]", "see imu-align matrix --help"]),
@@ -45,13 +45,14 @@ def one_line(res, code=2):
     (("calibrate", "magg", "x.csv"), ["imu-align calibrate: unknown command magg (did you mean mag?)"]),
     (("calibrate", "mag"), ["imu-align calibrate mag: missing argument LOG"]),
     (("--verbose",), ["imu-align: unknown option --verbose", "see imu-align --help"]),
-])
+]))
 def test_usage_error_is_one_line_with_status_2(args, words):
     line = one_line(run(*args))
     for w in words:
         assert w in line, line
 
 
+@pytest.mark.slow
 def test_python_dash_m_behaves_the_same():
     line = one_line(run("budget", "mount.toml", "--montecarlo", "10", entry=MODULE))
     assert "did you mean --monte-carlo?" in line
@@ -65,11 +66,13 @@ def test_version():
     assert res.stdout.strip() == f"imu-align {__version__}"
 
 
+@pytest.mark.slow
 def test_library_error_is_one_line_with_its_status(tmp_path):
     line = one_line(run("matrix", tmp_path / "absent.csv", "--plan", tmp_path / "absent.toml"))
     assert line.startswith("imu-align: error:") and "file not found" in line
 
 
+@pytest.mark.slow
 def test_internal_error_is_one_line_and_debug_shows_the_traceback(tmp_path):
     mount = tmp_path / "m.toml"
     mount.write_text("this is not toml = = =\n")
@@ -82,6 +85,7 @@ def test_internal_error_is_one_line_and_debug_shows_the_traceback(tmp_path):
     assert res.returncode == 1 and "Traceback" in res.stderr and "ZeroDivisionError" in res.stderr
 
 
+@pytest.mark.slow
 def test_help_exits_0_on_stdout():
     for args in ((), ("matrix",), ("calibrate",), ("calibrate", "mag")):
         res = run(*args, "--help")

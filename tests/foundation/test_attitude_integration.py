@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import coning
 from scipy.spatial.transform import Rotation
+from support import coning
 
 from align.attitude import increments, integrate, quat_from_rotvec, quat_multiply, quat_to_matrix, rotation
 

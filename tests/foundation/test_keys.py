@@ -1,7 +1,7 @@
 """Foundation, keys: unknown keys refused with the nearest valid one; every bundled input still loads."""
 
 import pytest
-from conftest import ROOT
+from support import ROOT
 
 from align.alignment.plan import Plan
 from align.errors import InputError

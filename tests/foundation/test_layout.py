@@ -7,7 +7,7 @@ import importlib
 import re
 
 import pytest
-from conftest import ROOT
+from support import ROOT
 
 LIBRARY = [p for p in sorted((ROOT / "align").rglob("*.py")) if "cli" not in p.relative_to(ROOT / "align").parts]
 LIBRARY += sorted((ROOT / "mechanics").glob("*.py"))

@@ -75,6 +75,7 @@ def test_rotation_vector_matches_scipy():
         assert np.allclose(rotation_vector(r), Rotation.from_matrix(r).as_rotvec(), atol=1e-9)
 
 
+@pytest.mark.slow
 def test_from_angles_matches_the_sympy_form():
     from align.sensitivity import ELEMENTS, matrix_from_angles
 

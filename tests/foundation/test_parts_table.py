@@ -1,7 +1,7 @@
 """The presets and a user's parts table: parsing, overriding, labels, and a refusal that names the field."""
 
 import pytest
-from conftest import ROOT
+from support import ROOT
 
 from align.errors import InputError
 from align.io import read_toml

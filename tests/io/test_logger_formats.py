@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pandas as pd
 import pytest
-from conftest import SHARED
+from support import SHARED
 
 from align.errors import InputError, UnitError
 from align.io import (

@@ -13,7 +13,7 @@ import json
 import tomllib
 
 import pytest
-from conftest import ROOT
+from support import ROOT
 
 from align.errors import InputError
 

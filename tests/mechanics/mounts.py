@@ -1,6 +1,6 @@
 """Mount inputs shared by the mechanics tests: the reference's Example 1 (optionally edited)."""
 
-from conftest import ROOT
+from support import ROOT
 
 from align.io import read_toml
 from mechanics.mount import Mount, mount_from_dict

@@ -61,6 +61,7 @@ def test_budget_round_trips_through_a_file_with_its_monte_carlo(tmp_path):
     assert back.elements("worst") == pytest.approx(full.elements("worst"), rel=1e-12)
 
 
+@pytest.mark.slow
 def test_budget_cli_writes_json_and_pictures(tmp_path, run_cli):
     out, png, pic, glb = tmp_path / "b.json", tmp_path / "h.png", tmp_path / "a.png", tmp_path / "a.glb"
     res = run_cli("budget", EXAMPLE1, "--monte-carlo", "20000", "--seed", "1", "--json", out, "--plot", png,

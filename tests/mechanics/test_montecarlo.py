@@ -9,6 +9,7 @@ from mechanics.budget import budget
 from mechanics.montecarlo import MonteCarlo, monte_carlo
 
 
+@pytest.mark.slow
 def test_worst_case_bounds_monte_carlo_and_is_approached():
     m = example1()
     b = budget(m)
@@ -26,6 +27,7 @@ def test_worst_case_bounds_monte_carlo_and_is_approached():
     assert screws.maximum[2] == pytest.approx(0.0, abs=1e-12)   # skew about z leaves the z axis alone
 
 
+@pytest.mark.slow
 def test_monte_carlo_mean_squares_add_where_rss_is_valid():
     # independent, zero-mean, small terms: the mean square of the whole equals the sum of the parts
     m = example1()

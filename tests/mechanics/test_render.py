@@ -12,6 +12,7 @@ from mechanics.render import assembly_glb, assembly_png, histogram_png, resting_
 PNG = b"\x89PNG\r\n\x1a\n"
 
 
+@pytest.mark.slow
 def test_pictures_of_example1():
     m = example1()
     b = budget(m)

@@ -30,6 +30,7 @@ def test_rest_model_reproduces_eq2_and_eq3_on_two_levels():
 
 
 @pytest.mark.parametrize("size", [(0.047, 0.044, 0.006), (0.04, 0.04, 0.005), (0.03, 0.05, 0.008)])
+@pytest.mark.slow
 def test_closed_form_rest_equals_hull_and_linear_programme(size):
     pads = _corner_pads(*size)
     geo = corner_geometry(pads)

@@ -6,7 +6,7 @@ import json
 
 import numpy as np
 import pytest
-from conftest import ROOT
+from support import ROOT
 
 from align.navigation.mission import rotation_mission
 from align.navigation.montecarlo import monte_carlo
@@ -14,6 +14,7 @@ from align.navigation.residuals import ResidualErrors, SensorErrors
 from align.units import DEG, DEG_H, STANDARD_GRAVITY, parse_quantity
 
 
+@pytest.mark.slow
 def test_static_drift_file_and_picture(run_cli, tmp_path):
     out, png = tmp_path / "drift.json", tmp_path / "drift.png"
     r = run_cli("drift", "--imu", "ADIS16485", "--gyro-bias", "10 deg/h", "--accel-bias", "1 mg", "--duration", "1 min",
@@ -45,6 +46,7 @@ def test_static_drift_file_and_picture(run_cli, tmp_path):
     assert res.errors.gyro.white[0] == pytest.approx(parse_quantity("0.3 deg/sqrt(h)", "angle_random_walk"))
 
 
+@pytest.mark.slow
 def test_a_mounting_misalignment_costs_nothing_at_rest_and_its_angle_times_the_turn_when_turning():
     # a 90 deg turn about z with gyro axes tilted by theta in random directions: the x and y gyros pick up
     # dM_xz and dM_yz times the turn; integrated in the turning frame, |tilt|^2 = 2 (dM_xz^2 + dM_yz^2) for 90 deg,

@@ -46,6 +46,7 @@ def test_the_dominance_is_stated_plainly(result):
     assert all({"quantity", "from_s", "to_s", "term", "share"} <= set(r) for r in result.dominant)
 
 
+@pytest.mark.slow
 def test_picture_and_report_section(result):
     from align.present.navigation import drift_plot_png, drift_summary, navigation_section
 

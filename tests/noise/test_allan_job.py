@@ -4,11 +4,12 @@ import json
 
 import numpy as np
 import pytest
-from conftest import SHARED
+from support import SHARED
 
 ADIS = SHARED / "data" / "static" / "adis16405_smac"
 
 
+@pytest.mark.slow
 def test_allan_cli_on_real_adis16405_and_plan_from_it(tmp_path, run_cli):
     """Two 2.78 h static runs of an ADIS16405: each run's curve and fit, the pooled curve, repeatability, plot, plan."""
     out, png = tmp_path / "allan.json", tmp_path / "allan.png"

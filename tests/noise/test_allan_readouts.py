@@ -123,6 +123,7 @@ def test_summary_shows_values_only_where_identified_in_engineering_units():
     assert lines and all("±" not in ln for ln in lines)
 
 
+@pytest.mark.slow
 def test_plot_y_range_comes_from_the_data_not_from_unidentified_terms():
     from align.present.plots import allan_plot_png, allan_ylim
 

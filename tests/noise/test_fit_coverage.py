@@ -63,6 +63,7 @@ def _coverage(fits, k: int, truth: float) -> tuple[float, float]:
     return float(np.mean(one)), float(np.mean(three))
 
 
+@pytest.mark.slow
 def test_day_records_recover_n_b_k_with_honest_sigmas(day_records):
     fits = day_records
     est = np.array([f.params[1:4] for f in fits])
@@ -79,6 +80,7 @@ def test_day_records_recover_n_b_k_with_honest_sigmas(day_records):
         assert np.all(np.isfinite(f.upper) == ~np.array(f.identifiable))
 
 
+@pytest.mark.slow
 def test_short_records_bound_what_they_cannot_identify(short_records):
     fits = short_records
     est = np.array([f.params[1:3] for f in fits])
@@ -103,6 +105,7 @@ def test_short_records_bound_what_they_cannot_identify(short_records):
     assert sum(not f.identifiable[3] for f in fits) >= 15
 
 
+@pytest.mark.slow
 def test_readouts_carry_intervals_and_read_where_defined(day_records):
     for f in day_records[:5]:
         r = f.readouts

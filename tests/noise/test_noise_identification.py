@@ -98,6 +98,7 @@ def test_lag1_and_b1_rules():
         noise_type_name(3)
 
 
+@pytest.mark.slow
 def test_greenhall_edf_matches_allantools_and_exact_counts():
     import allantools as at
 
@@ -118,6 +119,7 @@ def test_greenhall_edf_matches_allantools_and_exact_counts():
             assert edf_greenhall(2, m, n_phase) == pytest.approx(big_m)
 
 
+@pytest.mark.slow
 def test_result_interface_and_coverage_of_the_68_percent_interval():
     rng = np.random.default_rng(5)
     y = rng.standard_normal((20_000, 2))

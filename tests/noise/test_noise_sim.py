@@ -9,6 +9,7 @@ from align.noise.sim import NoiseSpec, seed_method_a, seed_method_b, seed_restor
 from align.units import parse_quantity as q
 
 
+@pytest.mark.slow
 def test_simulator_checks_itself_other_terms():
     k = q("30 deg/h/sqrt(h)", "rate_random_walk")
     f = _fit(NoiseSpec(white=ARW, random_walk=k), 3)

@@ -5,8 +5,8 @@ import io
 
 import numpy as np
 import pytest
-from conftest import SHARED
 from scipy.spatial.transform import Rotation
+from support import SHARED
 
 from align.calibration import calibrate_magnetometer
 from align.errors import InputError
@@ -31,6 +31,7 @@ def decoded(png: bytes):
     return img
 
 
+@pytest.mark.slow
 def test_ellipse_outline_is_the_shadow_of_the_ellipsoid():
     rng = np.random.default_rng(0)
     for _ in range(5):
@@ -85,6 +86,7 @@ def test_heading_error_after_calibration_matches_monte_carlo_of_the_hard_iron():
     assert np.allclose(np.std(errs, axis=0), after, rtol=0.06)
 
 
+@pytest.mark.slow
 def test_magnetometer_picture_of_a_real_capture():
     import pandas as pd
 
@@ -98,6 +100,7 @@ def test_magnetometer_picture_of_a_real_capture():
         magnetometer_png(raw[:, :2], cal)
 
 
+@pytest.mark.slow
 def test_accel_statics_picture_of_a_simulated_session_and_its_refusals():
     rng = np.random.default_rng(2)
     fs, ups = 100.0, Rotation.random(8, random_state=3).apply([0, 0, STANDARD_GRAVITY])
@@ -118,6 +121,7 @@ def test_accel_statics_picture_of_a_simulated_session_and_its_refusals():
         accel_statics_png(t[:-1], acc, intervals, "m/s^2")
 
 
+@pytest.mark.slow
 def test_apply_traces_picture_short_and_long():
     for n in (500, 300_000):  # a long log is drawn as its min/max envelope
         t = np.arange(n) / 100.0

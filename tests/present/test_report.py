@@ -11,7 +11,7 @@ import sys
 
 import numpy as np
 import pytest
-from conftest import in_chromium
+from support import in_chromium
 
 
 @pytest.fixture(scope="module")
@@ -22,6 +22,7 @@ def demo_dir(tmp_path_factory):
     return out, res.stdout
 
 
+@pytest.mark.slow
 def test_demo_summary_and_results(demo_dir):
     out, text = demo_dir
     assert "source total 1.3043 deg" in text and "binding phi_yz = 1.9102 deg" in text and "62.83 deg/h" in text
@@ -36,6 +37,7 @@ def test_demo_summary_and_results(demo_dir):
     assert np.all(np.abs(np.array(align["M"]) - truth) < 4 * np.array(align["uncertainty"]["M"]))
 
 
+@pytest.mark.slow
 def test_report_is_self_contained_and_every_picture_decodes(demo_dir):
     from PIL import Image
 
@@ -54,6 +56,7 @@ def test_report_is_self_contained_and_every_picture_decodes(demo_dir):
 
 
 @pytest.mark.skipif(shutil.which("chromium") is None, reason="Chromium not installed (CI installs it)")
+@pytest.mark.slow
 def test_report_in_headless_chromium(demo_dir, tmp_path):
     shot = tmp_path / "shot.png"
     assert in_chromium(demo_dir[0] / "report.html", tmp_path, shot, "1100,2000") == "images 4 broken 0"
@@ -78,6 +81,7 @@ def test_start_up_imports_nothing_heavy():
     assert res.stdout.strip() == "[]"
 
 
+@pytest.mark.slow
 def test_progress_bar_only_on_a_terminal(tmp_path):
     from align.present.story import DEMO
 

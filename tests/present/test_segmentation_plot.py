@@ -60,6 +60,7 @@ def _inside(span, runs, t, tol):
     return any(t[a] - tol <= span.t_start and span.t_end <= t[b - 1] + tol for a, b in runs)
 
 
+@pytest.mark.slow
 def test_png_is_a_picture_of_sensible_size(rate_session):
     from PIL import Image
 
@@ -123,6 +124,7 @@ def _drawn(monkeypatch, t, g, r):
     return out
 
 
+@pytest.mark.slow
 def test_the_picture_shades_one_span_per_segment_and_motion(monkeypatch):
     """A session with a 90 deg re-orientation about z between the plan's steps 2 and 3 (truth from the simulator):
     the motion is drawn hatched and labelled, each step and static period shaded once, at its times."""
@@ -164,6 +166,7 @@ def test_bad_input_is_one_line(rate_session):
         segmentation_plot_png(t, g, r, units="m/s")
 
 
+@pytest.mark.slow
 def test_the_report_holds_the_picture_when_a_log_and_plan_are_given(tmp_path):
     from PIL import Image
 
@@ -182,6 +185,7 @@ def test_the_report_holds_the_picture_when_a_log_and_plan_are_given(tmp_path):
     assert alt not in page
 
 
+@pytest.mark.slow
 def test_a_million_samples_draw_in_under_three_seconds():
     plan = Plan.standard_rate(100 * DEG)
     t, g, _ = _session(plan, seed=3, spec=SessionSpec(fs=2000.0, dwell_s=80.0, static_s=3.0))

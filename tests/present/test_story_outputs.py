@@ -4,7 +4,7 @@ nothing is in the demo's folder before its run commits."""
 import shutil
 
 import pytest
-from conftest import ROOT
+from support import ROOT
 
 from align.errors import InputError
 from align.io.outputs import Outputs

@@ -39,6 +39,7 @@ def test_angle_vector_is_reference_section_1():
         assert all(v[k] == pytest.approx(phi[k], abs=1e-12) for k in phi)
 
 
+@pytest.mark.slow
 def test_angle_sigmas_match_monte_carlo():
     rng = np.random.default_rng(1)
     m = Rotation.from_rotvec([0.004, -0.007, 0.01]).as_matrix().T * np.array([[1.002], [0.999], [1.001]])

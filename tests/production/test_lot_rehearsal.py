@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pyarrow.parquet as pq
+import pytest
 from _lots import cli, make_lot
 from scipy import stats as sst
 
@@ -192,6 +193,7 @@ def _check_a_local_dask_cluster_gives_the_same_table(lot):
     np.testing.assert_array_equal(a[list(FIGURES)].to_numpy(float), b[list(FIGURES)].to_numpy(float))
 
 
+@pytest.mark.slow
 def test_a_lot_of_200_units_through_batch_and_lot_against_its_truth(tmp_path):
     lot = _run_lot(tmp_path)
     for check in (_check_the_batch_ran_every_unit_and_says_how_many_failed,

@@ -1,4 +1,5 @@
-"""The batch runner with stand-in workers: a worker that dies, and Ctrl-C in the middle of a lot."""
+"""The batch runner with stand-in workers: a worker that dies, and Ctrl-C in the middle of a lot; when workers may be
+forks of the batch's process."""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ from align.production.pools import ProcessPool
 
 def _tasks(folder: Path, n: int) -> list[Task]:
     units = [Unit(f"U{k}", "allan", folder / f"U{k}.csv", None, (), None, k, f"line {k + 2}") for k in range(n)]
-    return [Task(u, ("allan", str(u.log)), folder / "units" / f"{u.serial}.json", (u.log,), "run1") for u in units]
+    return [Task(u, folder / "units" / f"{u.serial}.json", (u.log,), "run1") for u in units]
 
 
 def dying_worker(task: Task) -> list[dict]:
@@ -24,7 +25,11 @@ def dying_worker(task: Task) -> list[dict]:
     return unit_rows(task, 3, f"imu-align: error: {task.unit.log.name}: too short", task.digest(), 0.01)
 
 
-def test_a_worker_that_dies_costs_its_unit_only(tmp_path):
+@pytest.mark.parametrize("fork", [True, False], ids=["forked", "fork-server"])
+def test_a_worker_that_dies_costs_its_unit_only(tmp_path, monkeypatch, fork):
+    import align.production.pools as pools
+
+    monkeypatch.setattr(pools, "_fork_is_safe", lambda: fork)  # both ways a worker starts
     tasks = _tasks(tmp_path, 6)
     with ProcessPool(1) as pool:
         run = run_units(tasks, dying_worker, pool, tmp_path, window=1)
@@ -53,3 +58,29 @@ def test_ctrl_c_in_the_middle_keeps_the_units_done(tmp_path):
 
 def failing_worker(task: Task) -> list[dict]:
     return unit_rows(task, 2, "imu-align: error: x: file not found", task.digest(), 0.01)
+
+
+def test_workers_are_forks_only_when_that_is_safe(monkeypatch):
+    """A fork of a process whose numba (GNU OpenMP) threads ran aborts, and one of a process with other threads may
+    hold their locks: the fork server then starts the workers."""
+    import sys
+    import threading
+    import types
+
+    import align.production.pools as pools
+
+    monkeypatch.setitem(sys.modules, "numba.np.ufunc.parallel", types.SimpleNamespace(_is_initialized=False))
+    if sys.platform != "linux" or threading.active_count() > 1:
+        pytest.skip("forks are not used here")
+    assert pools._fork_is_safe()
+    monkeypatch.setitem(sys.modules, "numba.np.ufunc.parallel", types.SimpleNamespace(_is_initialized=True))
+    assert not pools._fork_is_safe()
+    monkeypatch.setitem(sys.modules, "numba.np.ufunc.parallel", types.SimpleNamespace(_is_initialized=False))
+    stop = threading.Event()
+    other = threading.Thread(target=stop.wait)
+    other.start()
+    try:
+        assert not pools._fork_is_safe()
+    finally:
+        stop.set()
+        other.join()

@@ -5,7 +5,7 @@ import json
 
 import numpy as np
 import pytest
-from conftest import ROOT
+from support import ROOT
 
 from align.io import read_toml
 from align.results import load_result, save_result
@@ -148,6 +148,7 @@ def _series_manoeuvre(tmp_path):
     return manoeuvre_from_dict({"series": {"file": "rates.csv"}, "limits": {"y": "1 deg", "z": "1 deg"}}, "m", tmp_path)
 
 
+@pytest.mark.slow
 def test_series_allowable_writes_a_summary_not_the_samples_and_round_trips(tmp_path):
     man = _series_manoeuvre(tmp_path)
     a = allowable(man, directions=20).replace(inputs={"manoeuvre": "m.toml"})

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from conftest import ROOT
+from support import ROOT
 
 from align.errors import InputError
 from align.io import read_toml
@@ -27,6 +27,7 @@ def test_slow_rate_series_time_is_seconds_unless_stated(tmp_path):
     assert man.increments.sum(axis=0)[2] == pytest.approx(10 * DEG * t[-1], rel=1e-9)
 
 
+@pytest.mark.slow
 def test_rate_series_fixed_axis_matches_and_gap_is_refused(tmp_path):
     t = np.arange(0, 3.0, 0.01)
     rate = 20.0 * np.sin(np.pi * t / 3.0)  # deg/s about z, a smooth 38 deg turn
@@ -113,6 +114,7 @@ def test_misspelled_or_bad_manoeuvre_key_is_refused_by_name(tmp_path, text, word
     assert words in str(err.value) and "\n" not in str(err.value)
 
 
+@pytest.mark.slow
 def test_series_units_key_reads_rad_per_s_and_columns_may_be_a_list(tmp_path):
     _rates_csv(tmp_path, scale=DEG)   # the same turn written in rad/s
     ref = manoeuvre_from_dict({"series": {"file": "rates.csv", "units": "deg/s"}, "limits": {"z": "1 deg"}}, "m", tmp_path)

@@ -182,6 +182,7 @@ def test_the_version_enters_the_content_hash(tmp_path, monkeypatch):
     assert input_hash("matrix", ("--margin", "1 s"), [tmp_path / "log.csv"]) != before
 
 
+@pytest.mark.slow
 def test_the_report_draws_every_figure_keeps_tables_in_the_page_and_no_spec_legend_without_a_spec():
     import matplotlib
 

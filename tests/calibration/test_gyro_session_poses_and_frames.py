@@ -25,6 +25,7 @@ def _session(seed, k_ga=None, **spec):
     return run, *accel_frame_truth(m_a, m_g)
 
 
+@pytest.mark.slow
 def test_pose_1_never_runs_into_the_first_turn():
     """400 starts at 200 Hz: the detected pose 1 (the gyro bias) ends inside the true rest every time, although the
     accelerometer alone puts the end of the rest after the turn has begun in some (a turn about the vertical)."""
@@ -39,6 +40,7 @@ def test_pose_1_never_runs_into_the_first_turn():
 
 
 @pytest.mark.parametrize("columns", ["y,-x,z", "z,x,y", "-x,-y,z"])
+@pytest.mark.slow
 def test_a_gyro_turned_relative_to_the_accelerometer_is_fitted(columns):
     """Two chips, or gyro columns in another order: the fit starts from the 24 axis-to-axis rotations and finds
     M = P M_c (P the columns' rotation), inside its 3 sigma, with a note."""
@@ -79,6 +81,7 @@ def test_the_rotation_table_is_in_the_file_and_the_largest_residual_is_the_table
     assert back.rotations == rows and back.level == s.gyroscope.level and "29 degrees of freedom" in back.level
 
 
+@pytest.mark.slow
 def test_residuals_beyond_the_noise_point_to_the_g_sensitivity_model():
     """A g-sensitive gyro fitted without K_ga leaves residuals ~50x the noise's: a note says so and names the model;
     with K_ga modelled, or without g-sensitivity in the data, no such note."""
@@ -92,6 +95,7 @@ def test_residuals_beyond_the_noise_point_to_the_g_sensitivity_model():
     assert not any("noise explains" in n for n in modelled.notes + quiet.notes)
 
 
+@pytest.mark.slow
 def test_system_frame_1_sigma_includes_the_tables_and_disagreement_is_flagged():
     """Rate-table results of the same gyro with an error of known sigma: the system-frame M of both sensors
     inside 3 sigma for >= 99 % of the elements over 4 sessions x 25 tables (with R taken as exact: far fewer).

@@ -6,7 +6,7 @@ import json
 
 import numpy as np
 import pytest
-from conftest import SHARED
+from support import SHARED
 
 from align.results import load_result
 
@@ -39,6 +39,7 @@ def _inside(cal_json, truth_json, k=3.0):
     return got
 
 
+@pytest.mark.slow
 def test_seed_2094_a_first_turn_about_the_vertical_stays_out_of_the_bias(run_cli, s2094, tmp_path):
     """The review's case: the initial rest ran 1.2 s into the first turn, the gyro bias was 9 sigma off."""
     out, png = tmp_path / "cal.json", tmp_path / "session.png"
@@ -58,6 +59,7 @@ def test_seed_2094_a_first_turn_about_the_vertical_stays_out_of_the_bias(run_cli
         assert f"{r['turn_deg']:9.1f}" in res.out and f"{r['residual_deg']:9.3f}" in res.out
 
 
+@pytest.mark.slow
 def test_seed_2039_the_accelerometer_fit_finds_the_right_minimum(run_cli, tmp_path_factory, tmp_path):
     """The review's case: the |a| = g fit converged to an ellipsoid 10-130x too large and the gyro was blamed."""
     sim = _simulate(tmp_path_factory, 2039)
@@ -89,6 +91,7 @@ def test_refusals_name_the_sensor_and_its_options(run_cli, s2094, tmp_path):
     assert res.code == 2 and res.err.strip().endswith("name the columns with --accel-columns")
 
 
+@pytest.mark.slow
 def test_frame_of_another_gyro_is_refused_and_mounting_help(run_cli, s2094, tmp_path_factory, tmp_path):
     other = _simulate(tmp_path_factory, 7)
     res = run_cli("calibrate", "gyro", s2094 / "session.csv", "--frame", other / "truth.json")

@@ -1,0 +1,182 @@
+"""``apply`` checks the log against the result before it writes anything (issue 28, "apply checks nothing about the
+log against the result"): the unit's dimension against the result's, raw counts read as a rate, a magnetometer log
+in another field unit; and the one column convention (``--columns`` data names with ``--time-column``).
+
+The truth comes from outside the program: sessions simulated with a known model, written in a known unit."""
+
+import numpy as np
+import pytest
+from support import write_session
+
+from align.alignment.plan import Plan
+from align.alignment.simulate import SessionSpec, simulate_session
+from align.calibration.results import Calibration, CalibrationSet
+from align.io import write_csv
+from align.model import SensorModel
+from align.results import save_result
+from align.units import DEG
+from align.units import parse_quantity as q
+
+SPEC = SessionSpec(noise_density=q("0.3 deg/sqrt(h)", "angle_random_walk"))
+#: an MPU-6050 at +/-250 deg/s: 131 counts per deg/s
+LSB = 131.0
+MODEL = SensorModel(np.array([[1.003, 0.004, -0.002], [-0.003, 0.998, 0.005], [0.002, -0.004, 1.001]]),
+                    np.array([0.5, -0.4, 0.3]) * DEG)
+
+
+def one_line(res, code=2):
+    assert res.code == code, (res.code, res.out, res.err)
+    line = res.err.strip()
+    assert line.startswith("imu-align: error:") and "\n" not in line and "Traceback" not in res.err, res.err
+    return line
+
+
+@pytest.fixture(scope="module")
+def aligned(tmp_path_factory):
+    """A deg/s alignment result of MODEL, made by ``matrix`` from a simulated session."""
+    from align.cli import run
+
+    folder = tmp_path_factory.mktemp("aligned")
+    plan = Plan.standard_rate(100 * DEG)
+    t, g, _ = simulate_session(plan, MODEL, SPEC, 0)
+    log, plan_path = write_session(folder, t, g, plan)
+    result = folder / "alignment.json"
+    assert run(["matrix", str(log), "--plan", str(plan_path), "--json", str(result)]) == 0
+    return result
+
+
+def _counts_log(folder, rate_deg_s):
+    """A session of MODEL at ``rate_deg_s`` on the table, written in raw counts (131 per deg/s), and its true rates."""
+    plan = Plan.standard_rate(rate_deg_s * DEG)
+    t, g, w = simulate_session(plan, MODEL, SPEC, 5)
+    log = folder / "counts.csv"
+    write_csv(log, ["time", "gyro_x", "gyro_y", "gyro_z"], np.column_stack([t, np.round(g / DEG * LSB)]))
+    return log, w
+
+
+@pytest.mark.parametrize("rate", [100.0, 20.0])  # 13100 "deg/s" in a dwell; 2620 in a dwell but 93 at rest
+def test_a_raw_count_log_corrected_with_a_deg_s_result_is_refused(tmp_path, run_cli, aligned, rate):
+    log, _ = _counts_log(tmp_path, rate)
+    out = tmp_path / "c.csv"
+    line = one_line(run_cli("apply", log, "--alignment", aligned, "--out", out))
+    assert "counts.csv" in line and "--gyro-units" in line and "raw counts" in line, line
+    assert not out.exists()
+
+
+def test_the_same_log_with_the_size_of_one_count_is_corrected_to_the_true_rates(tmp_path, run_cli, aligned):
+    log, w = _counts_log(tmp_path, 20.0)
+    out = tmp_path / "c.csv"
+    res = run_cli("apply", log, "--alignment", aligned, "--out", out, "--gyro-units", "131 LSB/(deg/s)")
+    assert res.code == 0, res.err
+    written = np.loadtxt(out, delimiter=",", skiprows=1)[:, 1:]  # written in the log's unit: counts
+    err = np.abs(written / LSB * DEG - w)
+    assert np.median(err) < 0.05 * DEG, np.median(err) / DEG
+
+
+def test_a_deg_s_log_read_as_counts_is_refused(tmp_path, run_cli, aligned):
+    plan = Plan.standard_rate(100 * DEG)
+    t, g, _ = simulate_session(plan, MODEL, SPEC, 6)
+    log, _ = write_session(tmp_path, t, g, plan)
+    out = tmp_path / "c.csv"
+    line = one_line(run_cli("apply", log, "--alignment", aligned, "--out", out, "--gyro-units", "counts"))
+    assert "session.csv" in line or "--gyro-units" in line, line
+    assert "--gyro-units" in line and "raw counts" in line, line
+    assert not out.exists()
+
+
+def test_a_gyro_log_given_a_unit_of_another_dimension_is_refused(tmp_path, run_cli, aligned):
+    plan = Plan.standard_rate(100 * DEG)
+    t, g, _ = simulate_session(plan, MODEL, SPEC, 6)
+    log, _ = write_session(tmp_path, t, g, plan)
+    line = one_line(run_cli("apply", log, "--alignment", aligned, "--out", tmp_path / "c.csv", "--units", "m/s^2"))
+    assert "--units" in line and "'m/s^2'" in line and "alignment.json" in line, line
+
+
+def test_a_gyro_calibration_in_counts_needs_a_count_log_and_writes_deg_s(tmp_path, run_cli):
+    m = MODEL.M * LSB / DEG  # counts per rad/s
+    bias = MODEL.bias / DEG * LSB  # counts
+    cal = Calibration("gyroscope", m, bias, np.zeros((3, 3)), np.zeros(3), "counts", "test")
+    result = tmp_path / "cal.json"
+    save_result(result, CalibrationSet({"gyroscope": cal}, {}))
+    t = np.arange(500) / 100
+    w = np.column_stack([np.zeros(500), np.zeros(500), np.where(t > 2, 30.0, 0.0)]) * DEG
+    raw = w @ m.T + bias
+    log = tmp_path / "raw.csv"
+    write_csv(log, ["time", "gyro_x", "gyro_y", "gyro_z"], np.column_stack([t, raw]))
+    out = tmp_path / "c.csv"
+    line = one_line(run_cli("apply", log, "--alignment", result, "--out", out))  # default --gyro-units deg/s
+    assert "'deg/s'" in line and "counts" in line and "--gyro-units counts" in line, line
+    res = run_cli("apply", log, "--alignment", result, "--out", out, "--gyro-units", "counts")
+    assert res.code == 0, res.err
+    assert "(deg/s)" in res.out and "written in deg/s" in res.out, res.out
+    written = np.loadtxt(out, delimiter=",", skiprows=1)[:, 1:]
+    assert np.allclose(written, w / DEG, atol=1e-9)
+
+
+def test_a_gauss_log_read_as_ut_is_refused_though_the_hard_iron_hides_it(tmp_path, run_cli):
+    from align.calibration.magnetometer import calibrate_magnetometer
+
+    rng = np.random.default_rng(0)
+    u = rng.normal(size=(2000, 3))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    soft = np.array([[1.1, 0.05, 0.0], [0.05, 0.95, 0.02], [0.0, 0.02, 1.02]])
+    hard = np.array([12.0, -7.0, 3.0])  # uT: corrected, the gauss log reads |W h| = 14 uT, within Earth's range
+    raw_ut = (u * 48.0) @ soft.T + hard
+    result = tmp_path / "mag.json"
+    save_result(result, calibrate_magnetometer(raw_ut * 1e-6, "uT"))
+    log, out = tmp_path / "mag.csv", tmp_path / "corrected.csv"
+    write_csv(log, ["time", "mag_x", "mag_y", "mag_z"], np.column_stack([np.arange(len(u)) * 0.01, raw_ut / 100]))
+    line = one_line(run_cli("apply", log, "--alignment", result, "--out", out))
+    assert "mag.csv" in line and "gauss" in line and "--units gauss" in line, line
+    assert not out.exists()
+    res = run_cli("apply", log, "--alignment", result, "--out", out, "--units", "gauss")
+    assert res.code == 0, res.err
+    m = np.loadtxt(out, delimiter=",", skiprows=1)[:, 1:]
+    assert np.allclose(np.linalg.norm(m, axis=1), np.linalg.norm(m, axis=1).mean(), rtol=1e-6)
+
+
+# ------------------------------------------------------------------ the one column convention
+
+def _renamed(tmp_path):
+    plan = Plan.standard_rate(100 * DEG)
+    t, g, _ = simulate_session(plan, MODEL, SPEC, 7)
+    log = tmp_path / "renamed.csv"
+    write_csv(log, ["stamp", "wx", "wy", "wz"], np.column_stack([t, g / DEG]))
+    plan_path = tmp_path / "plan.toml"
+    plan_path.write_text(plan.to_toml())
+    return log, plan_path
+
+
+def test_time_column_and_three_data_columns_on_matrix_and_apply(tmp_path, run_cli):
+    import json
+
+    log, plan = _renamed(tmp_path)
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    assert run_cli("matrix", log, "--plan", plan, "--columns", "wx,wy,wz", "--time-column", "stamp", "--json", a).code == 0
+    assert run_cli("matrix", log, "--plan", plan, "--columns", "stamp,wx,wy,wz", "--json", b).code == 0
+    ra, rb = json.loads(a.read_text()), json.loads(b.read_text())
+    assert ra["M"] == rb["M"] and ra["inputs"]["columns"] == "stamp,wx,wy,wz"
+    out = tmp_path / "c.csv"
+    res = run_cli("apply", log, "--alignment", a, "--out", out, "--columns", "wx,wy,wz", "--time-column", "stamp")
+    assert res.code == 0, res.err
+    assert out.read_text().splitlines()[0].replace('"', "") == "stamp,wx,wy,wz"
+
+
+@pytest.mark.parametrize("command", ["matrix", "apply"])
+@pytest.mark.parametrize("columns, extra, words", [
+    ("wx,wx,wz", (), "named twice"),
+    ("stamp,wx,stamp,wz", (), "both the time column and a data column"),
+    ("wx,wy,wz", ("--time-column", "wx"), "both the time column and a data column"),
+    ("wx,wy", (), "give 3 names"),
+])
+def test_a_duplicate_or_missing_column_name_is_one_line_exit_2(tmp_path, run_cli, command, columns, extra, words):
+    log, plan = _renamed(tmp_path)
+    if command == "matrix":
+        args = ("matrix", log, "--plan", plan, "--json", tmp_path / "r.json")
+    else:
+        result = tmp_path / "a.json"
+        assert run_cli("matrix", log, "--plan", plan, "--columns", "stamp,wx,wy,wz", "--json", result).code == 0
+        args = ("apply", log, "--alignment", result, "--out", tmp_path / "c.csv")
+    line = one_line(run_cli(*args, "--columns", columns, *extra))
+    assert "--columns" in line and words in line, line
+    assert not (tmp_path / "r.json").exists() and not (tmp_path / "c.csv").exists()
