@@ -14,9 +14,9 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from align.cli import options as opt
+from align.cli.mounting import MountingOption, parse_mounting_option
 from align.cli.options import DURATION, POSITIVE, names
 from align.cli.paths import check_outputs, outputs
-from align.cli.mounting import MountingOption, parse_mounting_option
 
 if TYPE_CHECKING:
     from align.calibration.jobs import GyroInputs, GyroOptions
