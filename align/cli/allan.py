@@ -19,7 +19,7 @@ import typer
 
 from align.cli import options as opt
 from align.cli.options import ACCURACY, POSITIVE
-from align.cli.paths import check_outputs, outputs
+from align.cli.paths import check_outputs, write_run
 from align.cli.progress import progress
 
 GRIDS = ("dense", "octave", "decade")
@@ -130,11 +130,7 @@ def allan(
     with progress(inputs.samples, "Allan deviation (samples read)") as tick:
         result = ALLAN.stamp(ALLAN.compute(inputs, options, tick), options)
     extra = allan_files(result, inputs, params)  # all or none: the plot is drawn before anything is written
-    with outputs() as out:
-        for path, content in extra:
-            out.write_bytes(path, content)
-        if json_out is not None:
-            out.write_json(json_out, result)
+    write_run(json_out, result, extra)  # all or none
     typer.echo(allan_summary(result))
     if result.plan is not None:
         typer.echo("\n" + plan_summary(result.plan))

@@ -14,7 +14,7 @@ import typer
 
 from align.cli import options as opt
 from align.cli.options import value
-from align.cli.paths import check_outputs, data_files, outputs
+from align.cli.paths import check_outputs, data_files, write_run
 
 MANOEUVRE_HELP = "Manoeuvre TOML: [[rotation]] tables with axis and angle (or a [series]), and [limits]."
 Manoeuvre = opt.Arg(MANOEUVRE_HELP, "MANOEUVRE")
@@ -49,9 +49,7 @@ def allowable(
     if symbolic is not None:
         typer.echo(symbolic_text(value(symbolic)) + "\n")
     result = ALLOWABLE.stamp(ALLOWABLE.compute(inputs, opts, None), opts)
-    with outputs() as out:
-        if json_out is not None:
-            out.write_json(json_out, result)
+    write_run(json_out, result)
     typer.echo(allowable_summary(result))
 
 

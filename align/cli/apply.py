@@ -14,7 +14,7 @@ import typer
 
 from align.cli import options as opt
 from align.cli.options import value
-from align.cli.paths import check_outputs, outputs
+from align.cli.paths import check_outputs, write_run
 from align.vocab import Sensor
 
 #: the columns ``apply`` reads by default, per sensor, time first (:attr:`align.vocab.Sensor.columns`)
@@ -87,9 +87,7 @@ def apply(
     from align.alignment.jobs import APPLY
 
     result, inputs = APPLY.run_with_inputs(apply_options(**params))
-    with outputs() as staged:  # all or none: the picture is drawn before anything is written
-        for path, data in apply_files(result, inputs, params):
-            staged.write_bytes(path, data) if isinstance(data, bytes) else staged.write_text(path, data)
+    write_run(None, result, apply_files(result, inputs, params))  # all or none: the picture drawn before anything is written
     notes = "".join(f"; {n}" for n in result.notes)
     typer.echo(f"wrote {out}: {len(result.t)} rows of {result.sensor} data corrected with {alignment} "
                f"({result.units}){notes}")

@@ -14,7 +14,7 @@ import typer
 
 from align.cli import options as opt
 from align.cli.parts import PartsFile, parts_fields, parts_file
-from align.cli.paths import check_outputs, data_files, outputs
+from align.cli.paths import check_outputs, data_files, write_run
 from align.cli.progress import progress
 
 MOUNT_HELP = "Mount description TOML: [imu], [package], [ledges] or [baseplate], [screws]."
@@ -69,11 +69,7 @@ def budget(
     opts = budget_options(**params)
     with progress(monte_carlo, "Monte Carlo") as tick:
         result = BUDGET.run(opts, progress=tick)
-    with outputs() as out:  # all or none: every picture is drawn before anything is written
-        for path, data in budget_files(result, None, params):
-            out.write_bytes(path, data)
-        if json_out is not None:
-            out.write_json(json_out, result)
+    write_run(json_out, result, budget_files(result, None, params))  # all or none: every picture drawn first
     typer.echo(budget_summary(result))
 
 

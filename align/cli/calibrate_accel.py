@@ -15,7 +15,7 @@ import typer
 
 from align.cli import options as opt
 from align.cli.options import DURATION, POSITIVE
-from align.cli.paths import check_outputs, outputs
+from align.cli.paths import check_outputs, write_run
 
 if TYPE_CHECKING:
     from align.calibration.jobs import AccelInputs, AccelOptions
@@ -93,9 +93,5 @@ def accel(
     from align.present.text import calibration_summary
 
     result, inputs = ACCEL.run_with_inputs(accel_options(**params))
-    with outputs() as out:
-        if json_out is not None:
-            out.write_json(json_out, result)
-        for path, data in accel_files(result, inputs, params):
-            out.write_bytes(path, data) if isinstance(data, bytes) else out.write_text(path, data)
+    write_run(json_out, result, accel_files(result, inputs, params))  # all or none
     typer.echo(calibration_summary(result.sensors))

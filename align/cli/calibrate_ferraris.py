@@ -16,7 +16,7 @@ import typer
 
 from align.cli import options as opt
 from align.cli.options import NONZERO, POSITIVE, names, value
-from align.cli.paths import check_outputs, outputs
+from align.cli.paths import check_outputs, write_run
 
 if TYPE_CHECKING:
     from align.calibration.jobs import FerrarisOptions
@@ -88,9 +88,5 @@ def ferraris(
     from align.present.text import calibration_summary
 
     result, inputs = FERRARIS.run_with_inputs(ferraris_options(**params))
-    with outputs() as out:  # all or none
-        if json_out is not None:
-            out.write_json(json_out, result)
-        for path, data in ferraris_files(result, inputs, params):
-            out.write_bytes(path, data) if isinstance(data, bytes) else out.write_text(path, data)
+    write_run(json_out, result, ferraris_files(result, inputs, params))  # all or none
     typer.echo(calibration_summary(result.sensors))

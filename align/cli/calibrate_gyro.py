@@ -16,7 +16,7 @@ import typer
 from align.cli import options as opt
 from align.cli.mounting import MountingOption, parse_mounting_option
 from align.cli.options import DURATION, POSITIVE, names
-from align.cli.paths import check_outputs, outputs
+from align.cli.paths import check_outputs, write_run
 
 if TYPE_CHECKING:
     from align.calibration.jobs import GyroInputs, GyroOptions
@@ -174,10 +174,6 @@ def gyro(
     from align.present.text import calibration_summary
 
     result, inputs = GYRO.run_with_inputs(gyro_options(**params))
-    with outputs() as out:  # all or none
-        if json_out is not None:
-            out.write_json(json_out, result)
-        for path, data in gyro_files(result, inputs, params):
-            out.write_bytes(path, data) if isinstance(data, bytes) else out.write_text(path, data)
+    write_run(json_out, result, gyro_files(result, inputs, params))  # all or none
     typer.echo(calibration_summary(result.sensors))
     typer.echo(rotation_table(result.sensor("gyroscope").rotations))

@@ -15,7 +15,7 @@ import typer
 
 from align.cli import options as opt
 from align.cli.options import DIP, names, value
-from align.cli.paths import check_outputs, outputs
+from align.cli.paths import check_outputs, write_run
 
 if TYPE_CHECKING:
     from align.calibration.jobs import MagInputs, MagOptions
@@ -94,9 +94,5 @@ def mag(
     from align.present.text import magnetometer_summary
 
     result, inputs = MAG.run_with_inputs(opts)
-    with outputs() as out:
-        if json_out is not None:
-            out.write_json(json_out, result)
-        for path, data in mag_files(result, inputs, params):
-            out.write_bytes(path, data) if isinstance(data, bytes) else out.write_text(path, data)
+    write_run(json_out, result, mag_files(result, inputs, params))  # all or none
     typer.echo(magnetometer_summary(result))

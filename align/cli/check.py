@@ -17,7 +17,7 @@ from align.cli.allowable import Manoeuvre
 from align.cli.budget import Mount
 from align.cli.options import value
 from align.cli.parts import PartsFile, parts_fields, parts_file
-from align.cli.paths import check_outputs, data_files, outputs
+from align.cli.paths import check_outputs, data_files, write_run
 
 
 def check_options(*, mount: Path, manoeuvre: Path, basis: Any = "rss", parts: Path | None = None, **_: Any):
@@ -48,9 +48,7 @@ def check(
     from align.sensitivity.jobs import CHECK
 
     table, inputs = CHECK.run_with_inputs(check_options(**params))
-    with outputs() as out:
-        if json_out is not None:
-            out.write_json(json_out, table)
+    write_run(json_out, table)
     typer.echo(margin_summary(table.rows, table.basis))
     shown = preset_lines(inputs)
     if shown:

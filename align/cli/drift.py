@@ -16,7 +16,7 @@ import typer
 from align.cli import options as opt
 from align.cli.options import DIP, DURATION, NONNEGATIVE, POSITIVE, hertz, names
 from align.cli.parts import PartsFile, parts_fields, parts_file
-from align.cli.paths import check_outputs, data_files, outputs
+from align.cli.paths import check_outputs, data_files, write_run
 from align.cli.progress import progress
 
 #: a latitude is an angle from -90 deg to 90 deg, as a dip angle is
@@ -137,11 +137,7 @@ def drift(
 
     with progress(runs, "Monte Carlo") as tick:
         result = DRIFT.run(opts, progress=tick)
-    with outputs() as out:
-        for path, data in drift_files(result, None, params):
-            out.write_bytes(path, data)
-        if json_out is not None:
-            out.write_json(json_out, result)
+    write_run(json_out, result, drift_files(result, None, params))  # all or none
     typer.echo(drift_summary(result))
 
 

@@ -14,7 +14,7 @@ import typer
 
 from align.cli import options as opt
 from align.cli.options import DURATION, PAUSE, POSITIVE, TOLERANCE, value
-from align.cli.paths import check_outputs, outputs
+from align.cli.paths import check_outputs, write_run
 from align.vocab import Sensor
 
 #: the columns ``matrix`` reads by default, time first (the old spelling of ``--columns``, still accepted)
@@ -110,11 +110,7 @@ def matrix(
     from align.present.text import alignment_summary
 
     result, inputs = MATRIX.run_with_inputs(matrix_options(**params))
-    with outputs() as out:  # all or none: the picture is drawn before anything is written
-        for path, data in matrix_files(result, inputs, params):
-            out.write_bytes(path, data) if isinstance(data, bytes) else out.write_text(path, data)
-        if json_out is not None:
-            out.write_json(json_out, result)
+    write_run(json_out, result, matrix_files(result, inputs, params))  # all or none: the picture drawn first
     typer.echo(alignment_summary(result))
 
 

@@ -203,3 +203,17 @@ def outputs():
     from align.io.outputs import Outputs
 
     return Outputs()
+
+
+def write_run(json_out: Path | None, result, files: Iterable[tuple[Path, bytes | str]] = ()) -> None:
+    """A job's outputs, all or none: its JSON result (when asked) and the extra files its output options made
+    (``<command>_files``: pictures as bytes, headers and CSV as text), every one made before anything is written."""
+    files = list(files)
+    with outputs() as out:
+        if json_out is not None:
+            out.write_json(json_out, result)
+        for path, data in files:
+            if isinstance(data, bytes):
+                out.write_bytes(path, data)
+            else:
+                out.write_text(path, data)
