@@ -273,7 +273,13 @@ def simulate_session(plan: Plan, model: SensorModel, spec: SessionSpec = Session
 
     Parameters
     ----------
-    plan, model, spec, seed
+    plan : Plan
+        The table steps: axes, rates (rad/s) and durations (s).
+    model : SensorModel
+        The truth: ``M`` (3, 3), dimensionless, and ``bias`` (3,), rad/s (``g = M w + b``, Eq 14-15).
+    spec : SessionSpec
+        Sample rate (Hz), dwell and static times (s), noise density (rad/s/sqrt(Hz)), table errors.
+    seed : int or numpy.random.Generator
         As :func:`simulate_run`.
 
     Returns
@@ -284,6 +290,20 @@ def simulate_session(plan: Plan, model: SensorModel, spec: SessionSpec = Session
         Gyro readings, rad/s.
     w : ndarray, shape (n, 3)
         True angular rate of the system frame, rad/s (table, moves and Earth).
+
+    Examples
+    --------
+    Noise-free readings follow ``g = M w + b`` exactly (Eq 14-15):
+
+    >>> import numpy as np
+    >>> from align.alignment.plan import Plan
+    >>> from align.model import SensorModel
+    >>> from align.units import DEG
+    >>> M = np.array([[1.002, 0.003, -0.002], [-0.004, 0.998, 0.001], [0.002, -0.001, 1.001]])
+    >>> b = np.array([0.01, -0.02, 0.005]) * DEG
+    >>> t, g, w = simulate_session(Plan.standard_rate(100 * DEG), SensorModel(M, b), SessionSpec(noise_density=0.0))
+    >>> g.shape == w.shape == (len(t), 3), bool(np.allclose(g, w @ M.T + b, atol=1e-12))
+    (True, True)
     """
     run = _simulate(plan, model, spec, seed)
     return run["t"], run["g"], run["w"]

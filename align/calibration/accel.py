@@ -274,6 +274,19 @@ def calibrate_accel(means: dict, ups: dict, gravity: float = STANDARD_GRAVITY, u
         Readings that are not gravity in ``units`` (a unit mix-up), two orientations reading the
         same, positions not spanning 3-D, an axis reading the wrong way (``det(M) <= 0``: a handedness
         error naming the axis and its positions), a scale factor outside 1 +/- 0.2 (physical units).
+
+    Examples
+    --------
+    The six faces of a known ``[M | b]`` (``a_meas = M (g u) + b``): the least squares
+    ``K_hat = Y X^T (X X^T)^-1`` (reference section 5) returns it.
+
+    >>> import numpy as np
+    >>> M = np.array([[1.01, 0.002, -0.003], [0.001, 0.99, 0.004], [-0.002, 0.003, 1.005]])
+    >>> b = np.array([0.05, -0.03, 0.02])
+    >>> ups = {f"{s}{a}": k * np.eye(3)[i] for i, a in enumerate("xyz") for s, k in (("+", 1), ("-", -1))}
+    >>> cal = calibrate_accel({name: M @ (9.80665 * u) + b for name, u in ups.items()}, ups)
+    >>> bool(np.allclose(cal.M, M, atol=1e-9)), bool(np.allclose(cal.bias, b, atol=1e-9))
+    (True, True)
     """
     gravity = check_gravity(gravity)
     check_at_rest(np.linalg.norm(np.reshape(list(means.values()), (-1, 3)), axis=1), gravity, units)

@@ -209,6 +209,9 @@ def calibrate_gyro_session(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, acc_
     Returns
     -------
     GyroSession
+        The ``accelerometer`` and ``gyroscope`` calibrations (``raw = M x + b``, reference section 5), in the
+        accelerometer's frame: ``M`` (3, 3), ``bias`` (3,) in the readings' units; the poses, rotation reports
+        (angles in rad) and the fit's condition number.
 
     Raises
     ------
@@ -216,6 +219,24 @@ def calibrate_gyro_session(t: np.ndarray, acc: np.ndarray, gyr: np.ndarray, acc_
         Too few poses, a pose too short or not static, a rotation at the gyro's range, rotations that do
         not span 3-D, readings that are not gravity or rates in the units given, scale factors no
         accelerometer or gyro has, a gyro mirrored relative to the accelerometer (``det M < 0``).
+
+    Examples
+    --------
+    A simulated noise-free session (:mod:`align.calibration.posesim`) of 10 poses at 25 Hz, with the
+    poses given: the truth in the accelerometer's frame comes back.
+
+    >>> import numpy as np
+    >>> from align.calibration.posesim import PoseSessionSpec, accel_frame_truth, random_sensors, simulate_poses
+    >>> rng = np.random.default_rng(0)
+    >>> Ma, ba, Mg, bg = random_sensors(rng)
+    >>> spec = PoseSessionSpec(fs=25.0, poses=10, init_s=5.0, gyro_noise=0.0, accel_noise=0.0)
+    >>> s = simulate_poses(spec, Ma, ba, Mg, bg, rng)
+    >>> r = calibrate_gyro_session(s.t, s.acc, s.gyr, "m/s^2", "rad/s", intervals=list(s.poses))
+    >>> T, Mg_c, _ = accel_frame_truth(Ma, Mg)
+    >>> bool(np.allclose(r.accelerometer.M, T, atol=1e-9)), bool(np.allclose(r.gyroscope.M, Mg_c, atol=1e-5))
+    (True, True)
+    >>> bool(np.allclose(r.gyroscope.bias, bg, atol=1e-9))
+    True
     """
     t, acc, gyr = (np.asarray(x, float) for x in (t, acc, gyr))
     acc_where = where if accel_where is None else accel_where

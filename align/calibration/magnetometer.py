@@ -268,6 +268,8 @@ def calibrate_magnetometer(m: np.ndarray, units: str = "uT", field: float | None
     Returns
     -------
     MagCalibration
+        ``m_cal = W (m_raw - h)`` (seed 004, the sphere ``|m_cal| = F``): ``hard_iron`` ``h`` (3,) and ``field``
+        ``F`` in the unit of ``m``, ``soft_iron`` ``W`` (3, 3) dimensionless, ``heading_error`` rad.
 
     Raises
     ------
@@ -277,6 +279,17 @@ def calibrate_magnetometer(m: np.ndarray, units: str = "uT", field: float | None
     InputError
         Not three columns, NaN rows, too few samples, a known ``field`` that is not Earth's,
         a ``dip`` outside [-90, 90] deg.
+
+    Examples
+    --------
+    A 48 uT field on a sphere offset by a hard iron of (10, -5, 3) uT:
+
+    >>> import numpy as np
+    >>> v = np.random.default_rng(3).normal(size=(600, 3))
+    >>> m = (48.0 * v / np.linalg.norm(v, axis=1)[:, None] + [10.0, -5.0, 3.0]) * 1e-6
+    >>> cal = calibrate_magnetometer(m)
+    >>> np.round(np.asarray(cal.hard_iron) * 1e6, 3).tolist()
+    [10.0, -5.0, 3.0]
     """
     if model not in MODELS:
         raise InputError(f"unknown model '{literal(model)}'; choose {', '.join(MODELS)}", "{model}")

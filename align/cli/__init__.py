@@ -185,7 +185,8 @@ def _usage_message(exc: Exception, path: list[str], args: list[str]) -> str:
     if "BadParameter" in kinds and param is not None:
         given = _given(param, args)
         cause = exc.__cause__ or exc.__context__  # typer < 0.27 keeps the parser's reason only there
-        if (not text or text == given) and isinstance(cause, ValueError) and str(cause):
+        bare = given is None and " " not in text  # the value itself (typer < 0.27 from a parser called directly)
+        if (not text or text == given or bare) and isinstance(cause, ValueError) and str(cause):
             text = " ".join(str(cause).split()).removeprefix("Value error, ").rstrip(".")
         if given is None or repr(given) in text:
             return f"invalid value for {_flag(param)}: {text}"

@@ -186,8 +186,27 @@ def _output_names(job: str) -> set[str]:
     return {p.name for p in _click(job).params if set(getattr(p, "opts", ())) & set(OUTPUT_OPTIONS)}
 
 
-def _absolute(value: Any, folder: Path) -> Any:
-    """A path value resolved against the manifest's ``folder`` (lists of paths too); other values as they are."""
+def _path_params(job: str) -> frozenset[str]:
+    """The parameters of ``job``'s command declared as paths (typer gives some click versions' values as text)."""
+    import typing
+
+    callback = _click(job).callback
+    found = set()
+    for name, hint in typing.get_type_hints(callback, include_extras=True).items():
+        base = typing.get_args(hint)[0] if typing.get_origin(hint) is typing.Annotated else hint
+        kinds = typing.get_args(base) or (base,)
+        if Path in kinds or any(Path in (typing.get_args(k) or (k,)) for k in kinds):
+            found.add(name)
+    return frozenset(found)
+
+
+def _absolute(value: Any, folder: Path, path: bool = False) -> Any:
+    """A path value resolved against the manifest's ``folder`` (lists of paths too); other values as they are.
+    ``path``: the parameter is a path even when the parser gave it as text."""
+    if path and isinstance(value, str):
+        value = Path(value)
+    if path and isinstance(value, (list, tuple)) and value and all(isinstance(v, str) for v in value):
+        value = type(value)(Path(v) for v in value)
     if isinstance(value, Path):
         return (folder / value).resolve()
     if isinstance(value, (list, tuple)) and value and all(isinstance(v, Path) for v in value):
@@ -277,7 +296,9 @@ def prepare_unit(unit, folder: Path, where: str, cache: dict | None = None) -> P
     from align.cli.builders import options_builder
     from align.cli.paths import check_outputs
 
-    params = {name: _absolute(value, folder) for name, value in _parsed(unit, folder, where, cache).items()}
+    paths = _path_params(unit.job)
+    params = {name: _absolute(value, folder, name in paths)
+              for name, value in _parsed(unit, folder, where, cache).items()}
     outs = _output_names(unit.job)
     asked = {name: params[name] for name in outs if params.get(name) is not None}
     try:  # as the single command: its outputs checked, then its options built

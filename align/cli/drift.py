@@ -24,12 +24,13 @@ LATITUDE = DIP
 MAX_RUNS = 1_000_000
 
 
-def _trajectory_source(trajectory: Path, gyro_columns: str | None, time_column: str | None, rate_hz: float,
+def _trajectory_source(trajectory: Path, gyro_columns: str | None, time_column: str | None, rate_hz: float | None,
                        gyro_units: str, skip_rows: int, comment, delimiter, time_units):
-    """The trajectory's gyro columns as a LogSource: three names are read at ``--rate-hz`` (drift always has a
-    rate) unless ``--time-column`` names the time; four names, or none, read the time column."""
+    """The trajectory's gyro columns as a LogSource, by the one column convention: its time column (``time``,
+    ``--time-column``, or the first of four names) is read, unless ``--rate-hz`` is given with three names and no
+    ``--time-column`` (a log without time); a log with neither is refused naming both options."""
     given = None if gyro_columns is None else names(gyro_columns)
-    at_rate = given is not None and len(given) == 3 and time_column is None
+    at_rate = rate_hz is not None and given is not None and len(given) == 3 and time_column is None
     return opt.log_source(trajectory, gyro_columns, rate_hz if at_rate else None, gyro_units, time_column,
                           skip_rows, comment, delimiter, time_units)
 
@@ -38,7 +39,7 @@ def drift_options(*, duration: float | None = None, allan: list[Path] | None = N
                   budget: Path | None = None, mount_error: Any = "attitude", imu: str | None = None,
                   parts: Path | None = None, manoeuvre: Path | None = None, trajectory: Path | None = None,
                   gyro_columns: str | None = None, accel_columns: str | None = None, time_column: str | None = None,
-                  gyro_units: str = "deg/s", accel_units: str = "m/s^2", runs: int = 1000, rate_hz: float = 100.0,
+                  gyro_units: str = "deg/s", accel_units: str = "m/s^2", runs: int = 1000, rate_hz: float | None = None,
                   nav_rate: float | None = None, turn_rate: float | None = None, heading: float = 0.0,
                   latitude: float | None = None, earth_rate: bool = False, gyro_bias: float | None = None,
                   accel_bias: float | None = None, flicker_span: int = 8, seed: int = 0, skip_rows: int = 0,
@@ -55,8 +56,9 @@ def drift_options(*, duration: float | None = None, allan: list[Path] | None = N
         duration=duration, allan=tuple(allan or ()), alignment=alignment, budget=budget,
         mount_error=opt.value(mount_error), imu=imu, manoeuvre=manoeuvre, trajectory=source,
         accel_columns=None if accel_columns is None else tuple(names(accel_columns)), accel_units=accel_units,
-        runs=runs, rate_hz=rate_hz, nav_rate=nav_rate, heading=heading, earth_rate=earth_rate, gyro_bias=gyro_bias,
-        accel_bias=accel_bias, flicker_span=flicker_span, seed=seed, **more, **parts_fields(parts))
+        runs=runs, rate_hz=100.0 if rate_hz is None else rate_hz, nav_rate=nav_rate, heading=heading,
+        earth_rate=earth_rate, gyro_bias=gyro_bias, accel_bias=accel_bias, flicker_span=flicker_span, seed=seed,
+        **more, **parts_fields(parts))
 
 
 def drift_files(result, inputs, params: dict) -> list[tuple[Path, bytes | str]]:
@@ -102,8 +104,8 @@ def drift(
     gyro_units: opt.GyroUnits("Gyro unit of --trajectory, e.g. deg/s or rad/s.") = "deg/s",
     accel_units: opt.UnitFlag("--accel-units", "Accelerometer unit of --trajectory, e.g. m/s^2 or g.") = "m/s^2",
     runs: opt.Whole("--runs", "Monte Carlo runs (2 to 1,000,000).", 2, MAX_RUNS, "1000") = 1000,
-    rate_hz: opt.RateHz("Sensor sample rate of the mission (of a --trajectory without a time column).",
-                        required=True) = 100.0,
+    rate_hz: opt.RateHz("Sensor sample rate of the mission (default 100 Hz), or of a --trajectory without a time "
+                        "column.") = None,
     nav_rate: Annotated[float | None, typer.Option("--nav-rate", parser=hertz, metavar="HZ", help=(
         "Navigation update rate (default 10 Hz, at most the sample rate), Hz, e.g. 10 or '10 Hz'."))] = None,
     turn_rate: opt.Quantity("--turn-rate", "angular_rate", "Mean rate of a manoeuvre's rotations.", "RATE", POSITIVE,

@@ -119,7 +119,7 @@ COMMAND_FLAGS: dict[str, dict[str, str]] = {
     "calibrate ferraris": {"units": "--accel-units", "columns": "--accel-columns or --gyro-columns"},
     "calibrate accel": {"units": "--accel-units"},
     "calibrate mag": {"units": "--mag-units", "columns": "--columns or --accel-columns"},
-    "drift": {"manoeuvre": "--manoeuvre"},
+    "drift": {"manoeuvre": "--manoeuvre", "columns": "--gyro-columns or --accel-columns"},
 }
 
 #: command -> old flag -> its name today; accepted, not shown in --help

@@ -97,7 +97,8 @@ def report(
     noise_ratio: NoiseRatio = 10.0,
     memory_limit_mb: opt.Number("--memory-limit-mb", "Static recording: phase kept in memory up to this size (MB); "
                                 "beyond it, a temporary file (as allan's).", POSITIVE, "2000", "MB") = 2000.0,
-    gyro_units: opt.GyroUnits("Unit of the rate-table log (--log).") = "deg/s",
+    gyro_units: opt.GyroUnits("Unit of the rate-table log (--log); without --log and --alignment, of the static "
+                              "recording (--allan), as allan's --gyro-units.") = "deg/s",
     gyro_columns: opt.Columns("Columns of the rate-table log (--log): time,x,y,z (x,y,z with --log-rate-hz). Default "
                               "time,gyro_x,gyro_y,gyro_z; for --alignment, the columns the result records.",
                               "--gyro-columns", optional=True) = None,
@@ -143,6 +144,11 @@ def report(
     if allan_log is not None and allan_log.suffix.lower() != ".json":  # a static record: as `allan REC` reads it
         from align.cli.allan import allan_options
 
+        if log is None and alignment is None and gyro_units != "deg/s":  # no rate-table log: as `allan --gyro-units`
+            if units != "deg/s":
+                raise InputError("give the static recording's unit once: {units} or {gyro_units} (without {log}, "
+                                 "--gyro-units is the recording's, as allan's)", "{gyro_units}")
+            units = gyro_units
         allan_opts = allan_options(logs=[allan_log], columns=columns, rate_hz=rate_hz, units=units,
                                    time_column=time_column, grid=grid, per_decade=per_decade, modified=modified,
                                    rate=rate, accuracy=accuracy, noise_ratio=noise_ratio,

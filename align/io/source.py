@@ -15,7 +15,7 @@ option means the same on every command:
 
 Public names
 ------------
-LogSource, column_names, DEFAULT_TIME
+LogSource, column_names, check_distinct, DEFAULT_TIME
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ from align.io.formats import LogFormat
 from align.io.logs import SensorLog, read_sensor_log
 from align.vocab import Sensor
 
-__all__ = ["LogSource", "column_names", "DEFAULT_TIME"]
+__all__ = ["LogSource", "column_names", "check_distinct", "DEFAULT_TIME"]
 
 #: the time column's name when none is given
 DEFAULT_TIME = "time"
@@ -180,6 +180,11 @@ class LogSource:
         return read_sensor_log(self.path, cols, units, time, self.rate_hz, expect=expect, log_format=self.format,
                                counts=counts, field=field or ("gyro_units" if sensor is Sensor.GYROSCOPE else "units"))
 
+    def data_names(self, sensor: Sensor, field: str = "columns") -> list[str]:
+        """The data columns :meth:`read` reads for ``sensor``: those given, or the defaults the file holds."""
+        time, cols = self.names(sensor, field=field)
+        return cols if self.columns is not None else self._defaults_present(sensor, cols, time)
+
     def _defaults_present(self, sensor: Sensor, cols: list[str], time: str | None) -> list[str]:
         """The default names, or the first old set the file's header holds when it lacks the defaults."""
         header = self.header()
@@ -216,3 +221,23 @@ class LogSource:
         return {"log": str(self.path), "columns": None if self.columns is None else ",".join(self.columns),
                 "time_column": self.time_column, "rate_hz": self.rate_hz, "units": self.units,
                 **self.format.to_dict()}
+
+
+def check_distinct(first: tuple[Sensor, Sequence[str], str], second: tuple[Sensor, Sequence[str], str]) -> None:
+    """Refuse one column named for two sensors of one file (``(sensor, names, field)`` each).
+
+    Raises
+    ------
+    InputError
+        Naming the column, both sensors and the second sensor's option (``{field}``).
+
+    Examples
+    --------
+    >>> check_distinct((Sensor.GYROSCOPE, ["gx", "gy", "gz"], "gyro_columns"),
+    ...                (Sensor.ACCELEROMETER, ["ax", "ay", "az"], "accel_columns"))
+    """
+    (s1, n1, _), (s2, n2, field2) = first, second
+    for name in n2:
+        if name in n1:
+            raise InputError(f"'{literal(name)}' is both a {s1.value} and an {s2.value} column; name each column "
+                             "once", "{" + field2 + "}")

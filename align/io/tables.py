@@ -249,7 +249,7 @@ def _require(names: list[str] | None, available: list[str], path, time_column: s
     if missing:
         advice = "name the columns with {columns}"
         if missing == [time_column]:
-            advice = "give {rate_hz} for a log without time, or " + advice
+            advice = "name its time column with {time_column}, give {rate_hz} for a log without time, or " + advice
         hint = preamble_hint(Path(path), fmt) if fmt is not None else None
         listed = ", ".join(shown(a) for a in available) or "none"
         raise InputError(f"no column {', '.join(repr(shown(m)) for m in missing)} (columns: {listed}); "

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from align.errors import InputError
-from align.io.source import LogSource
+from align.io.source import LogSource, check_distinct
 from align.job import Job, Progress
 from align.navigation.mission import Mission
 from align.navigation.residuals import MOUNT_ERRORS, ResidualErrors
@@ -201,9 +201,12 @@ def _trajectory(options: DriftOptions, settings: dict[str, Any]) -> Mission:
     src = options.trajectory
     assert src is not None
     time_col, _ = src.names(Sensor.GYROSCOPE, field="gyro_columns")
-    gyr = src.read(Sensor.GYROSCOPE, field="gyro_units", columns_field="gyro_columns")
     acc_src = dataclasses.replace(src, columns=options.accel_columns, units=options.accel_units,
                                   time_column=time_col or src.time_column)
+    if src.columns is not None or acc_src.columns is not None:  # one file: no column named for both sensors
+        check_distinct((Sensor.GYROSCOPE, src.data_names(Sensor.GYROSCOPE, "gyro_columns"), "gyro_columns"),
+                       (Sensor.ACCELEROMETER, acc_src.data_names(Sensor.ACCELEROMETER, "accel_columns"), "accel_columns"))
+    gyr = src.read(Sensor.GYROSCOPE, field="gyro_units", columns_field="gyro_columns")
     acc = acc_src.read(Sensor.ACCELEROMETER, field="accel_units", columns_field="accel_columns")
     path = src.path
     step = np.diff(gyr.t)

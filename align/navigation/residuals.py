@@ -307,6 +307,15 @@ def residual_errors(allan=(), correction=None, budget=None, part=None, gyro_bias
     Returns
     -------
     ResidualErrors
+        1-sigma per sensor (R1), SI: ``bias`` (3,), ``matrix`` (3, 3), ``tilt`` (3,), rad, and the noise terms (3,);
+        ``mount`` (3,), rad (R2).
+
+    Examples
+    --------
+    >>> from align.units import DEG_H
+    >>> err = residual_errors(gyro_bias=10 * DEG_H)
+    >>> err.terms(), round(float(err.gyro.bias[2] / DEG_H), 6)
+    ([('gyroscope', 'bias')], 10.0)
     """
     where = where or {}
     values: dict[str, dict] = {"gyroscope": {}, "accelerometer": {}}

@@ -251,6 +251,18 @@ def navigate(w: np.ndarray, f: np.ndarray, dt: float, q0: np.ndarray | None = No
     Returns
     -------
     Trajectory
+        ``t`` (K + 1,), s; ``q`` (K + 1, 4) body to NED; ``v`` (m/s) and ``p`` (m), (K + 1, 3), NED.
+
+    Examples
+    --------
+    Level and at rest but turning at 0.1 rad/s about the down axis for 10 s: the heading reaches
+    1 rad, and the specific force ``(0, 0, -g)`` cancels gravity (no velocity, no position).
+
+    >>> import numpy as np
+    >>> w, f = np.tile([0.0, 0.0, 0.1], (1001, 1)), np.tile([0.0, 0.0, -9.80665], (1001, 1))
+    >>> tr = navigate(w, f, 0.01, gravity=9.80665)
+    >>> round(float(tr.t[-1]), 6), round(float(tr.euler[-1, 2]), 6), float(np.abs(tr.p).max())
+    (10.0, 1.0, 0.0)
     """
     if not (np.isfinite(dt) and dt > 0):
         raise InputError("the sample interval must be finite and positive", "{rate_hz}")

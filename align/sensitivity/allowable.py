@@ -200,6 +200,19 @@ def allowable(man: Manoeuvre, directions: int = 200) -> Allowable:
     -------
     Allowable
         Per element the allowance (rad) and how it was found; the binding element, the cone (rad).
+
+    Examples
+    --------
+    The reference's Example 2 (a 30 deg heading change about z, y and z outputs within 1 deg each):
+    ``phi_yz <= asin(1/30)`` binds, ``psi_z <= acos(29/30)``.
+
+    >>> from align.sensitivity.manoeuvre import Manoeuvre
+    >>> from align.units import DEG
+    >>> man = Manoeuvre([[0, 0, 30 * DEG]], {"y": 1 * DEG, "z": 1 * DEG}, fixed_axis=True,
+    ...                 segments=[("z", 30 * DEG)])
+    >>> a = allowable(man, directions=50)
+    >>> a.binding, round(a.binding_value / DEG, 4), round(a.allowable["psi_z"] / DEG, 3)
+    ('phi_yz', 1.9102, 14.835)
     """
     from scipy.optimize import brentq
 

@@ -152,5 +152,21 @@ def check_margins(budget_elements: dict, allow: Allowable, basis: str) -> Margin
     -------
     MarginTable
         One row per element; ``passed`` when every prediction is within its allowance.
+
+    Examples
+    --------
+    Example 2's allowance (``phi_yz`` <= 1.9102 deg) against a budget of 0.5 deg per element, then 2 deg on ``phi_yz``:
+
+    >>> from align.sensitivity.allowable import allowable
+    >>> from align.sensitivity.manoeuvre import Manoeuvre
+    >>> from align.units import DEG
+    >>> man = Manoeuvre([[0, 0, 30 * DEG]], {"y": 1 * DEG, "z": 1 * DEG}, fixed_axis=True,
+    ...                 segments=[("z", 30 * DEG)])
+    >>> allow = allowable(man, directions=50)
+    >>> check_margins(dict.fromkeys(allow.allowable, 0.5 * DEG), allow, "rss").passed
+    True
+    >>> table = check_margins({**dict.fromkeys(allow.allowable, 0.5 * DEG), "phi_yz": 2 * DEG}, allow, "rss")
+    >>> table.passed, [m.element for m in table.rows if m.predicted > m.allowed]
+    (False, ['phi_yz'])
     """
     return MarginTable(basis, tuple(margins(budget_elements, allow)))

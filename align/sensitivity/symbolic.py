@@ -192,5 +192,15 @@ def sensitivity(w: npt.ArrayLike, angles: dict[str, float] | npt.ArrayLike) -> n
     -------
     ndarray, shape (3, 9)
         Columns in :data:`ELEMENTS` order, unit of ``w`` per rad.
+
+    Examples
+    --------
+    Aligned axes (all angles 0) and a unit rate about z: only the x and y gyros' cross-axis
+    angles toward z (``phi_xz``, ``phi_yz``) change the readings to first order (Eq 5-10).
+
+    >>> import numpy as np
+    >>> J = sensitivity([0.0, 0.0, 1.0], np.zeros(9))
+    >>> J.shape, [ELEMENTS[j] for j in np.flatnonzero(np.abs(J).max(axis=0) > 1e-12)]
+    ((3, 9), ['phi_xz', 'phi_yz'])
     """
     return np.array(_lambdified()[1](tuple(_angle_vector(angles)), list(np.asarray(w, float))), dtype=float)

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pyarrow.parquet as pq
@@ -81,6 +82,8 @@ def _manifest(path, rows):
 
 
 def _alone(job, log, plan, options) -> list[str]:
+    """The single command of a unit, its files named as the batch names them (resolved against the manifest)."""
+    log, plan = Path(log).resolve(), None if plan is None else Path(plan).resolve()
     return [*job.split(), str(log), *([PLAN_FLAG[job], str(plan)] if plan is not None else []), *options]
 
 

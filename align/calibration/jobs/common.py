@@ -16,7 +16,7 @@ from typing import Any
 from align.calibration.accel import StaticDetector
 from align.errors import InputError
 from align.io.logs import SensorLog
-from align.io.source import LogSource
+from align.io.source import LogSource, check_distinct
 from align.vocab import Sensor
 
 __all__ = ["SOURCE_FIELDS", "log_source", "read_sensor", "shown_columns", "same_file", "accel_source", "units_of",
@@ -56,10 +56,14 @@ def same_file(a: LogSource, b: LogSource) -> bool:
 
 
 def accel_source(log: LogSource, accel: LogSource | None) -> LogSource:
-    """The accelerometer's source: ``accel``, or its default columns in m/s^2 in ``log``'s file."""
-    if accel is not None:
-        return accel
-    return LogSource(path=log.path, time_column=log.time_column, rate_hz=log.rate_hz, format=log.format)
+    """The accelerometer's source: ``accel``, or its default columns in m/s^2 in ``log``'s file; in one file, no
+    column named for both sensors (:func:`align.io.source.check_distinct`)."""
+    acc = accel if accel is not None else LogSource(path=log.path, time_column=log.time_column, rate_hz=log.rate_hz,
+                                                    format=log.format)
+    if same_file(log, acc) and (log.columns is not None or acc.columns is not None):
+        check_distinct((Sensor.GYROSCOPE, log.data_names(Sensor.GYROSCOPE, "gyro_columns"), "gyro_columns"),
+                       (Sensor.ACCELEROMETER, acc.data_names(Sensor.ACCELEROMETER, "accel_columns"), "accel_columns"))
+    return acc
 
 
 def units_of(src: LogSource, sensor: Sensor) -> str:
