@@ -16,7 +16,7 @@ A job is two steps, so that a caller that also draws the readings (``--plot``) r
 
 Public names
 ------------
-Job, Progress
+Job, Progress, fields_signature
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ from typing import Any, Generic, TypeVar
 from align.provenance import Provenance
 from align.results import Result
 
-__all__ = ["Job", "Progress"]
+__all__ = ["Job", "Progress", "fields_signature"]
 
 #: ``progress(n)``: n more units of work done (samples read, runs made); the library never draws it
 Progress = Callable[[int], None]
@@ -100,3 +100,36 @@ class Job(Generic[O, I, R]):
 def describe(job: Job[Any, Any, Any]) -> str:
     """``name: summary`` of a job, for listings."""
     return f"{job.name}: {job.summary}" if job.summary else job.name
+
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def fields_signature(options: type) -> Callable[[F], F]:
+    """Give a job's keyword-only call (``def matrix(*, progress=None, **fields)``) the signature of its options:
+    ``help()``, ``inspect.signature`` and an editor then list every field with its default.
+
+    The call's own keyword parameters come first; each field of the frozen ``options`` dataclass that the call
+    does not name follows, keyword-only, with its default (``dataclasses.MISSING``: required).
+    """
+    import dataclasses
+    import inspect
+
+    def decorate(fn: F) -> F:
+        own = [p for p in inspect.signature(fn).parameters.values() if p.kind is not inspect.Parameter.VAR_KEYWORD]
+        named = {p.name for p in own}
+        extra = []
+        for f in dataclasses.fields(options):
+            if f.name in named or not f.init:
+                continue
+            default = (f.default if f.default is not dataclasses.MISSING
+                       else f.default_factory() if f.default_factory is not dataclasses.MISSING  # type: ignore[misc]
+                       else inspect.Parameter.empty)
+            extra.append(inspect.Parameter(f.name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=f.type))
+        required = [p for p in extra if p.default is inspect.Parameter.empty]
+        optional = [p for p in extra if p.default is not inspect.Parameter.empty]
+        fn.__signature__ = inspect.signature(fn).replace(parameters=[*own, *required, *optional])  # type: ignore[attr-defined]
+        return fn
+
+    return decorate
+

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from align.job import Job, Progress
+from align.job import Job, Progress, fields_signature
 from mechanics.budget import Budget
 from mechanics.budget import budget as compute_budget
 from mechanics.montecarlo import monte_carlo as run_monte_carlo
@@ -163,6 +163,7 @@ BUDGET: Job[BudgetOptions, BudgetInputs, Budget] = Job(
     "mounting-misalignment budget: source formulas, worst case and Monte Carlo")
 
 
+@fields_signature(BudgetOptions)
 def budget(*, progress: Progress | None = None, **fields: Any) -> Budget:
     """The mounting-misalignment budget of a mount, as ``imu-align budget`` computes it.
 

@@ -26,7 +26,7 @@ import numpy as np
 
 from align.errors import InputError
 from align.io.source import LogSource, check_distinct
-from align.job import Job, Progress
+from align.job import Job, Progress, fields_signature
 from align.navigation.mission import Mission
 from align.navigation.residuals import MOUNT_ERRORS, ResidualErrors
 from align.navigation.result import DriftResult
@@ -288,6 +288,7 @@ DRIFT: Job[DriftOptions, DriftInputs, DriftResult] = Job(
     "attitude, velocity and position error growth from the residual sensor errors over a mission")
 
 
+@fields_signature(DriftOptions)
 def drift(*, progress: Progress | None = None, **fields: Any) -> DriftResult:
     """Attitude, velocity and position error growth over a mission, as ``imu-align drift`` computes it.
 

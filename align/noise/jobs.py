@@ -23,18 +23,11 @@ from typing import Any
 from align.errors import InputError
 from align.io.formats import LogFormat
 from align.io.source import LogSource
-from align.job import Job, Progress
+from align.job import Job, Progress, fields_signature
 from align.noise._provenance import PrehashedJob
 from align.noise.analysis import AllanAnalysis, plan_from_allan, run_allan
 from align.noise.planner import PlanResult, make_plan, model_curve, preset_model
-from align.noise.records import (
-    MOTION_ACCELERATION,
-    MOTION_RATE,
-    AllanInputs,
-    allan_columns,
-    allan_unit,
-    read_records,
-)
+from align.noise.records import MOTION_ACCELERATION, MOTION_RATE, AllanInputs, allan_columns, allan_unit, read_records
 from align.units import to_unit
 
 __all__ = ["AllanOptions", "AllanInputs", "ALLAN", "allan", "allan_unit", "allan_columns", "PlanOptions",
@@ -177,6 +170,7 @@ def _from_sources(logs: Any, fields_: dict[str, Any]) -> tuple[tuple[Path, ...],
     return tuple(paths), {**shared, **fields_}
 
 
+@fields_signature(AllanOptions)
 def allan(*, logs: str | Path | LogSource | Sequence[str | Path | LogSource], progress: Progress | None = None,
           **fields_: Any) -> AllanAnalysis:
     """Allan deviation, five-term noise fit and noise figures of static recordings: ``imu-align allan``.
@@ -374,6 +368,7 @@ PLAN: Job[PlanOptions, PlanInputs, PlanResult] = Job(
     "Averaging time per table step for an alignment goal (Example 3), and the whole plan")
 
 
+@fields_signature(PlanOptions)
 def plan(*, progress: Progress | None = None, **fields_: Any) -> PlanResult:
     """The test plan for an alignment goal: ``imu-align plan``.
 

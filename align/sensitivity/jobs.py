@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from align.errors import InputError
-from align.job import Job, Progress
+from align.job import Job, Progress, fields_signature
 from align.sensitivity.allowable import Allowable
 from align.sensitivity.allowable import allowable as compute_allowable
 from align.sensitivity.manoeuvre import Manoeuvre
@@ -108,6 +108,7 @@ ALLOWABLE: Job[AllowableOptions, AllowableInputs, Allowable] = Job(
     "allowable misalignment per element for a manoeuvre, the binding element and the cone")
 
 
+@fields_signature(AllowableOptions)
 def allowable(*, progress: Progress | None = None, **fields: Any) -> Allowable:
     """The allowable misalignment of each element for a manoeuvre, as ``imu-align allowable`` computes it.
 
@@ -244,6 +245,7 @@ CHECK: Job[CheckOptions, CheckInputs, MarginTable] = Job(
     "the mounting budget against the allowance, element by element")
 
 
+@fields_signature(CheckOptions)
 def check(*, progress: Progress | None = None, **fields: Any) -> MarginTable:
     """A mount's budget against a manoeuvre's allowance, element by element, as ``imu-align check`` does.
 

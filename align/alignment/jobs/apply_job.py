@@ -23,7 +23,7 @@ from align.alignment.jobs.common import check_unit_given, names_read, source
 from align.errors import AlignError, InputError, UnitError, literal
 from align.io.logs import SensorLog, sensor_scale
 from align.io.source import LogSource
-from align.job import Job, Progress
+from align.job import Job, Progress, fields_signature
 from align.units import DEG_S, DIMENSIONS, parse_unit
 from align.vocab import Sensor
 
@@ -270,6 +270,7 @@ APPLY: Job[ApplyOptions, ApplyInputs, CorrectedLog] = Job(
     "correct a log with an alignment or a calibration result")
 
 
+@fields_signature(ApplyOptions)
 def apply(*, progress: Progress | None = None, **fields: Any) -> CorrectedLog:
     """A log corrected with an alignment or calibration result, as ``imu-align apply`` corrects it.
 

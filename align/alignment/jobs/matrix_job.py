@@ -22,7 +22,7 @@ from align.alignment.segment import Segment, SegmentOptions
 from align.errors import InputError, literal
 from align.io.logs import SensorLog
 from align.io.source import LogSource
-from align.job import Job, Progress
+from align.job import Job, Progress, fields_signature
 from align.units import DEG, DEG_S
 from align.vocab import Sensor
 
@@ -184,6 +184,7 @@ MATRIX: Job[MatrixOptions, MatrixInputs, AlignmentResult] = Job(
     "alignment matrix M and A = M^-1 from a rate-table log and its plan")
 
 
+@fields_signature(MatrixOptions)
 def matrix(*, progress: Progress | None = None, **fields: Any) -> AlignmentResult:
     """The alignment of a gyro from a rate-table log and its plan, as ``imu-align matrix`` computes it.
 

@@ -18,7 +18,7 @@ from align.calibration.jobs.common import detector_dict, log_source, read_sensor
 from align.calibration.results import CalibrationSet
 from align.io.logs import SensorLog
 from align.io.source import LogSource
-from align.job import Job, Progress
+from align.job import Job, Progress, fields_signature
 from align.vocab import Sensor
 
 __all__ = ["AccelOptions", "AccelInputs", "ACCEL", "calibrate_accel"]
@@ -121,6 +121,7 @@ ACCEL: Job[AccelOptions, AccelInputs, CalibrationSet] = Job(
     "accelerometer multi-position calibration (known orientations, or |a| = g over many attitudes)")
 
 
+@fields_signature(AccelOptions)
 def calibrate_accel(*, log: LogSource | str | Path, progress: Progress | None = None, **fields: Any) -> CalibrationSet:
     r"""Calibrate an accelerometer from static positions (``imu-align calibrate accel``).
 

@@ -20,7 +20,7 @@ from align.calibration.results import CalibrationSet
 from align.errors import InputError, literal
 from align.io.logs import SensorLog
 from align.io.source import LogSource
-from align.job import Job, Progress
+from align.job import Job, Progress, fields_signature
 from align.units import STANDARD_GRAVITY
 from align.vocab import Sensor
 
@@ -124,6 +124,7 @@ FERRARIS: Job[FerrarisOptions, FerrarisInputs, CalibrationSet] = Job(
     "accelerometer and gyro from a Ferraris session (six faces, three turns), as imucal records it")
 
 
+@fields_signature(FerrarisOptions)
 def ferraris(*, log: LogSource | str | Path, sections: str | Path, progress: Progress | None = None,
              **fields: Any) -> CalibrationSet:
     """Calibrate the accelerometer and the gyro of a Ferraris session (``imu-align calibrate ferraris``).

@@ -30,7 +30,7 @@ from align.calibration.results import CalibrationSet
 from align.errors import InputError
 from align.io.logs import SensorLog
 from align.io.source import LogSource
-from align.job import Job, Progress
+from align.job import Job, Progress, fields_signature
 from align.units import STANDARD_GRAVITY
 from align.vocab import Sensor
 
@@ -222,6 +222,7 @@ GYRO: Job[GyroOptions, GyroInputs, CalibrationSet] = Job(
     "gyro and accelerometer from rotations between static poses (imu_tk's method, no rate table)")
 
 
+@fields_signature(GyroOptions)
 def calibrate_gyro(*, log: LogSource | str | Path, progress: Progress | None = None, **fields: Any) -> CalibrationSet:
     """Calibrate the gyro and the accelerometer of a multi-position session (``imu-align calibrate gyro``).
 

@@ -21,7 +21,7 @@ from align.calibration.jobs.common import log_source, units_of
 from align.calibration.magnetometer import MagCalibration
 from align.errors import InputError, literal
 from align.io.source import LogSource, column_names
-from align.job import Job, Progress
+from align.job import Job, Progress, fields_signature
 from align.vocab import Sensor
 
 __all__ = ["MagOptions", "MagInputs", "MAG", "calibrate_mag"]
@@ -187,6 +187,7 @@ MAG: Job[MagOptions, MagInputs, MagCalibration] = Job(
     "magnetometer hard and soft iron (ellipsoid fit), and the misalignment from axis-down turns")
 
 
+@fields_signature(MagOptions)
 def calibrate_mag(*, log: LogSource | str | Path, progress: Progress | None = None, **fields: Any) -> MagCalibration:
     """Calibrate a magnetometer from a tumbling capture (``imu-align calibrate mag``).
 
