@@ -125,7 +125,7 @@ def fields_signature(options: type) -> Callable[[F], F]:
             default = (f.default if f.default is not dataclasses.MISSING
                        else f.default_factory() if f.default_factory is not dataclasses.MISSING  # type: ignore[misc]
                        else inspect.Parameter.empty)
-            extra.append(inspect.Parameter(f.name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=f.type))
+            extra.append(inspect.Parameter(f.name, inspect.Parameter.KEYWORD_ONLY, default=default))  # types: the options' docs
         required = [p for p in extra if p.default is inspect.Parameter.empty]
         optional = [p for p in extra if p.default is not inspect.Parameter.empty]
         fn.__signature__ = inspect.signature(fn).replace(parameters=[*own, *required, *optional])  # type: ignore[attr-defined]
