@@ -107,7 +107,8 @@ def _bare(path) -> dict:
 
 
 @pytest.mark.parametrize("k", range(7), ids=["matrix", "allan", "ferraris", "accel", "mag", "gyro", "matrix-files"])
-def test_a_unit_s_result_is_the_single_command_s(units, batch_run, run_cli, tmp_path, k):
+def test_a_unit_s_result_is_the_single_command_s(units, batch_run, run_cli, tmp_path, k, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # a row's relative output files, written by the single command here
     folder, ok, _ = units
     code, out, table = batch_run
     serial, job, log, plan, options = ok[k]
