@@ -299,8 +299,9 @@ def old_spelling(args: list[str]) -> list[str]:
     ``simulate session DIR ...``; ``simulate DIR --kind poses ...`` -> ``simulate poses DIR ...``;
     ``simulate DIR --lot N ...`` -> ``simulate lot DIR --lot N ...``. Other commands' words are returned as given.
 
-    A first word that names a subcommand is one (``simulate lot DIR``), unless no folder follows it
-    (``simulate lot --lot 200``: the old spelling with a folder named ``lot``).
+    A first word that names a subcommand is one (``simulate lot DIR``; ``simulate lot`` alone misses its folder),
+    unless no folder follows it and the old spelling's ``--lot``/``--kind`` does (``simulate lot --lot 200``: a
+    folder named ``lot``).
     """
     first = next((i for i, a in enumerate(args) if not a.startswith("-")), None)
     if first is None or args[first] != "simulate":
@@ -320,8 +321,9 @@ def old_spelling(args: list[str]) -> list[str]:
             continue
         positional.append(i)
         i += 1
-    if positional and rest[positional[0]] in SUBCOMMANDS and (len(positional) > 1 or "--help" in rest):
-        return args
+    old_words = any(w.split("=")[0] in ("--lot", "--kind") for w in rest)
+    if positional and rest[positional[0]] in SUBCOMMANDS and (len(positional) > 1 or "--help" in rest or not old_words):
+        return args  # a subcommand (without its folder: the usage error says so)
     if not positional:
         return args
     words = list(rest)

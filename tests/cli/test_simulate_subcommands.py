@@ -68,3 +68,12 @@ def test_help_lists_the_subcommands(run_cli):
     out = run_cli("simulate", "--help").out
     assert all(word in out for word in ("session", "poses", "lot"))
     assert "--lot" in run_cli("simulate", "lot", "--help").out
+
+
+def test_a_subcommand_without_its_folder_is_a_usage_error_not_a_folder_named_after_it(run_cli, tmp_path,
+                                                                                      monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    for sub in ("session", "poses", "lot"):
+        r = run_cli("simulate", sub)
+        assert r.code == 2 and "missing argument OUT_DIR" in r.err and r.err.count("\n") == 1
+    assert not any(tmp_path.iterdir())  # nothing written
