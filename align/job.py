@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Generic, TypeVar
 
-from align.provenance import Provenance
+from align.provenance import Provenance, start_hashing
 from align.results import Result
 
 __all__ = ["Job", "Progress", "fields_signature"]
@@ -88,12 +88,13 @@ class Job(Generic[O, I, R]):
         """
         if not isinstance(options, self.options):
             raise TypeError(f"{self.name} takes {self.options.__name__}, not {type(options).__name__}")
-        inputs = self.read(options)
-        return self.stamp(self.compute(inputs, options, progress), options)
+        return self.run_with_inputs(options, progress=progress)[0]
 
     def run_with_inputs(self, options: O, *, progress: Progress | None = None) -> tuple[R, I]:
-        """As :meth:`run`, and the checked inputs too (for a caller that also draws them)."""
+        """As :meth:`run`, and the checked inputs too (for a caller that also draws them). The input files'
+        SHA-256 is computed in the background while the job computes (:func:`align.provenance.start_hashing`)."""
         inputs = self.read(options)
+        start_hashing([p for p in self.files(options).values() if p is not None])
         return self.stamp(self.compute(inputs, options, progress), options), inputs
 
 

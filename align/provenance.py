@@ -4,9 +4,13 @@ Every job (:class:`align.job.Job`) stamps its result with a :class:`Provenance`,
 result file says which bytes it was computed from and how; the batch's content hash and a
 reviewer's "was this the file?" read the same record.
 
+A long log is hashed while the job computes: :func:`start_hashing` (called by :meth:`align.job.Job.run` once
+the inputs are read) starts the SHA-256 in a background thread (``hashlib`` releases the GIL), and
+:meth:`Provenance.of` takes it, or hashes the file then when it changed since or was never started.
+
 Public names
 ------------
-InputFile, Provenance, file_record, plain
+InputFile, Provenance, file_record, start_hashing, prehashed_record, plain
 """
 
 from __future__ import annotations
@@ -15,14 +19,16 @@ import dataclasses
 import enum
 import hashlib
 import math
+import threading
 from collections.abc import Mapping
+from concurrent.futures import Future
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from align import __version__
 
-__all__ = ["InputFile", "Provenance", "file_record", "plain"]
+__all__ = ["InputFile", "Provenance", "file_record", "start_hashing", "prehashed_record", "plain"]
 
 _CHUNK = 1 << 20
 
@@ -69,6 +75,59 @@ def file_record(role: str, path: str | Path) -> InputFile:
     return InputFile(role, str(path), size, digest.hexdigest())
 
 
+_LOCK = threading.Lock()
+#: (path, size, mtime_ns) -> the file's record being computed
+_PENDING: dict[tuple[str, int, int], Future] = {}
+
+
+def _key(path: str | Path) -> tuple[str, int, int] | None:
+    try:
+        st = Path(path).stat()
+    except OSError:
+        return None
+    return str(Path(path).resolve()), st.st_size, st.st_mtime_ns
+
+
+def start_hashing(paths: list[str | Path]) -> None:
+    """Start the SHA-256 of each file in a background thread (a file already started is not started again)."""
+    todo = []
+    with _LOCK:
+        for p in paths:
+            key = _key(p)
+            if key is not None and key not in _PENDING:
+                todo.append((key, p))
+    if not todo:
+        return
+    jobs = []
+    with _LOCK:
+        for key, p in todo:
+            future: Future = Future()
+            _PENDING[key] = future
+            jobs.append((future, p))
+
+    def work() -> None:
+        for future, p in jobs:
+            try:
+                future.set_result(file_record("", p))
+            except BaseException as exc:  # noqa: BLE001 - handed to the caller, who hashes again
+                future.set_exception(exc)
+
+    # a daemon thread: a run refused after this does not wait for the hash at exit
+    threading.Thread(target=work, name="imu-align-sha256", daemon=True).start()
+
+
+def prehashed_record(role: str, path: str | Path) -> InputFile:
+    """The file's record: the one computed in the background when the file is unchanged, else computed now."""
+    key = _key(path)
+    with _LOCK:
+        future = _PENDING.pop(key, None) if key is not None else None
+    if future is not None and future.exception() is None:
+        done = future.result()
+        if done.size >= 0 and _key(path) == key:
+            return InputFile(role, str(path), done.size, done.sha256)
+    return file_record(role, path)
+
+
 def plain(x: Any) -> Any:
     """A value as JSON holds it: dataclasses and mappings as dicts, paths as text, enums as their value,
     tuples as lists, non-finite floats as None."""
@@ -112,7 +171,7 @@ class Provenance:
     @classmethod
     def of(cls, job: str, files: Mapping[str, str | Path | None], options: Any) -> Provenance:
         """The provenance of a run of ``job`` on ``files`` (role -> path; None: not given) with ``options``."""
-        return cls(job, tuple(file_record(role, p) for role, p in files.items() if p is not None), plain(options))
+        return cls(job, tuple(prehashed_record(role, p) for role, p in files.items() if p is not None), plain(options))
 
     def to_dict(self) -> dict[str, Any]:
         return {"job": self.job, "files": [f.to_dict() for f in self.files], "options": self.options,

@@ -24,7 +24,6 @@ from align.errors import InputError
 from align.io.formats import LogFormat
 from align.io.source import LogSource
 from align.job import Job, Progress, fields_signature
-from align.noise._provenance import PrehashedJob
 from align.noise.analysis import AllanAnalysis, plan_from_allan, run_allan
 from align.noise.planner import PlanResult, make_plan, model_curve, preset_model
 from align.noise.records import MOTION_ACCELERATION, MOTION_RATE, AllanInputs, allan_columns, allan_unit, read_records
@@ -145,7 +144,7 @@ def allan_files(options: AllanOptions) -> dict[str, Path | None]:
     return {f"log {k}": p for k, p in enumerate(options.logs, 1)}
 
 
-ALLAN: Job[AllanOptions, AllanInputs, AllanAnalysis] = PrehashedJob(
+ALLAN: Job[AllanOptions, AllanInputs, AllanAnalysis] = Job(
     "allan", AllanOptions, read_allan, compute_allan, allan_files,
     "Allan deviation, noise-model fit and noise figures of static recordings")
 

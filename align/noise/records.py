@@ -25,7 +25,6 @@ import numpy as np
 from align.errors import InputError, UnitError, literal
 from align.io.formats import DETECT_BAND_HZ, TIME_UNITS, time_unit
 from align.io.source import DEFAULT_TIME, LogSource, column_names
-from align.noise._provenance import start_hashing
 from align.units import DIMENSIONS, STANDARD_GRAVITY, parse_unit
 from align.vocab import Sensor
 
@@ -348,6 +347,5 @@ def read_records(options: AllanOptions) -> AllanInputs:
             notes.append(f"{where}: time column read in {got.time_units} ({how}: {fs:.6g} Hz)")
         runs.append(got.data)
         files.append(where)
-    start_hashing(list(options.logs))  # the provenance's SHA-256, while the deviations are computed
     assert fs is not None  # at least one record was read
     return AllanInputs(tuple(runs), float(fs), tuple(names or ()), unit, tuple(files), tuple(notes))
