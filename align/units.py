@@ -8,7 +8,7 @@ so that a length given where an angle is expected is caught.
 Public names
 ------------
 parse_unit, parse_quantity, parse_scale, to_unit, format_quantity, unit_mixup_hint, Unit, DIMENSIONS, SHOWN_IN,
-COUNT_EXAMPLES, DEG, DEG_S, DEG_H, ARCSEC, MM, HOUR, STANDARD_GRAVITY
+COUNT_EXAMPLES, TEMPERATURE_UNITS, temperature_offset, DEG, DEG_S, DEG_H, ARCSEC, MM, HOUR, STANDARD_GRAVITY
 """
 
 from __future__ import annotations
@@ -377,3 +377,43 @@ def unit_mixup_hint(ratio: float) -> str | None:
         if abs(ratio / factor - 1) < 0.1:
             return f"measured rates are {ratio:.4g}x the plan's: {hint}"
     return None
+
+
+#: temperature units a log may state (an affine scale, so not a unit of :func:`parse_unit`): name -> (scale, offset)
+#: taking a reading to degrees Celsius, ``C = scale * x + offset``
+TEMPERATURE_UNITS = {"degC": (1.0, 0.0), "C": (1.0, 0.0), "°C": (1.0, 0.0), "celsius": (1.0, 0.0),
+                     "K": (1.0, -273.15), "kelvin": (1.0, -273.15),
+                     "degF": (5.0 / 9.0, -32.0 * 5.0 / 9.0), "F": (5.0 / 9.0, -32.0 * 5.0 / 9.0)}
+
+
+def temperature_offset(text: str, where: str | None = None) -> tuple[float, float]:
+    """The scale and offset that take a temperature reading in ``text`` to degrees Celsius.
+
+    Temperature stays in degrees Celsius inside (the unit every datasheet and firmware states
+    its temperature coefficients in), ``C = scale * x + offset``.
+
+    Parameters
+    ----------
+    text : str
+        ``"degC"`` (or ``"C"``), ``"K"``, ``"degF"``.
+    where : str, optional
+        The input that gave it, for messages.
+
+    Returns
+    -------
+    scale, offset : float
+
+    Raises
+    ------
+    UnitError
+        For any other text.
+
+    Examples
+    --------
+    >>> temperature_offset("K")
+    (1.0, -273.15)
+    """
+    key = text.strip() if isinstance(text, str) else text
+    if key not in TEMPERATURE_UNITS:
+        raise UnitError(f"'{literal(str(text))}' is not a temperature unit; give degC, K or degF", where)
+    return TEMPERATURE_UNITS[key]

@@ -10,7 +10,7 @@ shortcut (Eq 35-36).
 
 Each estimate is linear, ``x = L y`` (Eq E1), and its covariance is propagated through ``L`` (Eq E2): the
 noise inside the segments and, when the observations carry the bias-drift model
-(:class:`~align.alignment.drift.DriftObservation`, from :func:`~align.alignment.drift.with_drift`), the
+(:class:`~align.alignment.biasdrift.DriftObservation`, from :func:`~align.alignment.biasdrift.with_drift`), the
 bias change between the segments (Eq D2), and without a latitude the Earth rate segments share (Eq O3 of
 :mod:`~align.alignment.observe`), both also in :func:`fit_lsq`'s weights (generalised least squares, Eq E4);
 the bias is then the session bias, the mean of ``b(t)`` over the
@@ -29,7 +29,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from align.alignment.drift import DriftObservation
+from align.alignment.biasdrift import DriftObservation
 from align.alignment.observe import Observation
 from align.alignment.plan import Plan, axis_name
 from align.errors import TestError
@@ -119,7 +119,7 @@ def fit_lsq(obs: list[Observation], rate_accuracy: float = 0.0, method: str = "l
         From :func:`observe`: ``y`` (3,) a mean reading (rad/s; m/s^2 for an accelerometer)
         or a turn's integrated reading (rad); ``phi`` (4,) ``[w u; 1]``, ``[0; 1]`` or
         ``[theta u; T]``; ``var`` (3,) the variance of ``y``. Static periods or +/- pairs fix ``b``.
-        :class:`~align.alignment.drift.DriftObservation` s also carry the bias drift (Eq D2-D3).
+        :class:`~align.alignment.biasdrift.DriftObservation` s also carry the bias drift (Eq D2-D3).
     rate_accuracy : float
         Relative table accuracy (rate, or angle over the turn), dimensionless; 0 adds nothing.
     method : str
@@ -202,7 +202,7 @@ def fit_rate_pairs(obs: list[Observation], plan: Plan) -> Fit:
     With the table turning at ``+w`` and ``-w`` this is the source's ``(g(+) - g(-)) / (2 w)``; the
     bias is the average over the three pairs of the pairwise bias, assuming equal rates. The
     uncertainty is that of the linear map ``x = L y`` (:func:`_propagate`): the noise of the two dwells
-    and, for :class:`~align.alignment.drift.DriftObservation` s, the bias change between them (Eq D2),
+    and, for :class:`~align.alignment.biasdrift.DriftObservation` s, the bias change between them (Eq D2),
     inflated by the scatter of the residuals (the pairwise biases) beyond what that predicts.
 
     Parameters
@@ -242,7 +242,7 @@ def fit_angle_pairs(obs: list[Observation], plan: Plan) -> Fit:
     The bias cancels when both turns last equally long; otherwise the static periods' mean bias is removed
     first and reported (with no static period, the pairwise bias assuming equal durations is reported).
     The uncertainty is that of the linear map ``x = L y`` (:func:`_propagate`): the turns' noise, the
-    static bias' own error times ``T(+) - T(-)`` and, for :class:`~align.alignment.drift.DriftObservation` s,
+    static bias' own error times ``T(+) - T(-)`` and, for :class:`~align.alignment.biasdrift.DriftObservation` s,
     the bias change between the turns and the static periods times ``T`` (Eq D2), inflated by the
     scatter of the residuals beyond what that predicts.
 
@@ -309,7 +309,7 @@ def _closed_form_fit(obs: list[Observation], m: np.ndarray, bias: np.ndarray, lm
 
 def _errors(obs: list[Observation]) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None, np.ndarray | None]:
     """The observations' noise variances (k, 3); when they carry a drift model (all
-    :class:`~align.alignment.drift.DriftObservation`), its generalised covariance ``G`` (3, k, k) of the
+    :class:`~align.alignment.biasdrift.DriftObservation`), its generalised covariance ``G`` (3, k, k) of the
     segments' mean biases (Eq D2) and the session weights ``tau`` (k,), ``T_k / sum T``; when some carry a
     shared, unmodelled Earth term (:mod:`~align.alignment.observe`, Eq O3), its covariance ``E`` (3, k, k)."""
     shared = [o.earth for o in obs]

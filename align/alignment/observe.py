@@ -24,7 +24,7 @@ Without a latitude (or with the correction switched off) nothing is modelled (``
 ``w_earth = 0``), but the Earth rate is still there: a constant vector ``Omega_L`` of size ``Omega`` and unknown
 direction (latitude and heading unknown), taken as isotropic, ``cov(Omega_L) = Omega^2 / 3 I`` (Eq O1). What the
 geometry says about it is kept, so that nothing downstream mistakes it for a bias drift
-(:mod:`align.alignment.drift`) or for noise that averages out:
+(:mod:`align.alignment.biasdrift`) or for noise that averages out:
 
 * the component along a table axis ``a``, ``Omega_L . a``, is the same in every dwell, turn and static period
   with that axis: ``y_k`` holds ``E_k Omega_L`` with ``E_k = N u_k a^T`` (times ``T_k`` for a turn; ``u_k`` the

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from align.alignment.biasdrift import estimate_drift, with_drift
 from align.alignment.checks import (
     check_directions,
     check_durations,
@@ -24,7 +25,6 @@ from align.alignment.checks import (
     check_scale,
     check_span,
 )
-from align.alignment.drift import estimate_drift, with_drift
 from align.alignment.estimate import alignment_sigma, fit_angle_pairs, fit_lsq, fit_rate_pairs
 from align.alignment.geometry import mounting_label
 from align.alignment.match import Candidate, match_steps

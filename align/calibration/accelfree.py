@@ -33,7 +33,7 @@ import numpy as np
 
 from align.calibration.results import Calibration
 from align.errors import InputError, TestError
-from align.io.export import matrix_unit
+from align.io.consumers import matrix_unit
 from align.model import AXES
 from align.plausible import check_at_rest, check_gravity, scale_outside
 from align.units import STANDARD_GRAVITY

@@ -50,7 +50,7 @@ from align.calibration.results import Calibration
 from align.calibration.statics import common_intervals, initial_static_period, static_intervals
 from align.errors import InputError, TestError
 from align.io import check_log
-from align.io.export import matrix_unit
+from align.io.consumers import matrix_unit
 from align.plausible import check_at_rest, check_gravity, check_usable_model, scale_outside
 from align.units import DEG, STANDARD_GRAVITY
 from align.values import Value

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from align.errors import InputError
-from align.io.export import imucal_dict, matrix_unit
+from align.io.consumers import imucal_dict, matrix_unit
 from align.io.keys import check_keys
 from align.plausible import check_usable_model
 from align.results import Result, file_unit
@@ -231,7 +231,7 @@ class CalibrationSet(Result, format=FORMAT, convention=CONVENTION):
         return cal
 
     def as_imucal(self) -> dict:
-        """The pair as imucal's ``FerrarisCalibrationInfo`` JSON (see :func:`align.io.export.imucal_dict`)."""
+        """The pair as imucal's ``FerrarisCalibrationInfo`` JSON (see :func:`align.io.consumers.imucal_dict`)."""
         missing = [k for k in SENSORS if k not in self.sensors]
         if missing:
             raise InputError(f"imucal's format needs both sensors; this calibration has no {', '.join(missing)}")

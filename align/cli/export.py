@@ -82,7 +82,7 @@ def export(
     """A result in the format another program loads, stating its convention, frame, units and the tool version."""
     check_outputs(results, results=results, out=out)  # nor a data file a result names (its record of the inputs)
     _unused(value(to), name, rostopic)
-    from align.present.exports import export_text
+    from align.present.exportable import export_text
 
     text = export_text([(_load(p), str(p)) for p in results], value(to), name, rostopic or "/imu0")
     if out is None:

@@ -10,7 +10,7 @@ existing_file, read_text, decode_text, read_toml, read_json, write_json, write_t
 Outputs (``outputs``: a run's files written all together or not at all); c_header (from ``export``)
 """
 
-from align.io.export import c_header
+from align.io.consumers import c_header
 from align.io.files import (
            decode_text,
            existing_file,

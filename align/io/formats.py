@@ -17,7 +17,7 @@ seconds is stated with the result.
 
 Public names
 ------------
-LogFormat, TIME_UNITS, DELIMITERS, RATE_BAND_HZ, DETECT_BAND_HZ, delimiter_char, time_unit, csv_source, preamble_hint,
+LogFormat, TIME_UNITS, STAMPS, DELIMITERS, RATE_BAND_HZ, DETECT_BAND_HZ, delimiter_char, time_unit, csv_source, preamble_hint,
 content_lines
 """
 
@@ -33,6 +33,8 @@ from align.errors import InputError, literal
 
 #: time unit -> its size in seconds
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
+#: the kinds of time stamp a multi-stream log may carry (:attr:`LogFormat.stamps`)
+STAMPS = ("header", "record")
 #: the sample rates an IMU log may have, Hz (outside: not a sample interval, or the wrong time unit)
 RATE_BAND_HZ = (1.0, 1e5)
 #: the sample rates a unit is detected for, Hz (seconds also up to the top of :data:`RATE_BAND_HZ`)
@@ -75,12 +77,21 @@ class LogFormat:
     time_units : str or None
         Unit of the time column, one of :data:`TIME_UNITS`; None: detected from the median step
         (:func:`time_unit`).
+    topic : str or None
+        The stream of a log that holds several (:attr:`align.io.readers.LogReader.streams`): a ROS topic
+        (``/imu0``), a ULog topic with its instance (``sensor_gyro:1``), a DataFlash message (``IMU:1``);
+        None: the reader's choice (the only IMU stream, or the first instance), stated in the result.
+    stamps : str or None
+        Which time a stream's samples carry, where a format has two: ``"header"`` (the sensor's stamp) or
+        ``"record"`` (when the recorder wrote it); None: the format's default (the header stamp).
     """
 
     skip_rows: int = 0
     comment: str | None = None
     delimiter: str | None = None
     time_units: str | None = None
+    topic: str | None = None
+    stamps: str | None = None
 
     def __post_init__(self) -> None:
         if isinstance(self.skip_rows, bool) or not isinstance(self.skip_rows, int) or self.skip_rows < 0:
@@ -93,6 +104,11 @@ class LogFormat:
                               or c == self.separator):
             raise InputError(f"{literal(repr(c))} is not a comment character; give one character that starts a "
                              "comment and is not the delimiter, e.g. {comment=#}", "{comment}")
+        if self.topic is not None and (not isinstance(self.topic, str) or not self.topic.strip()):
+            raise InputError(f"{literal(repr(self.topic))} is not a topic; give its name, e.g. {{topic=/imu0}}", "{topic}")
+        if self.stamps is not None and self.stamps not in STAMPS:
+            raise InputError(f"{literal(repr(self.stamps))} is not a kind of time stamp; give one of "
+                             f"{', '.join(STAMPS)}", "{stamps}")
         if self.time_units is not None and self.time_units not in TIME_UNITS:
             raise InputError(f"{literal(repr(self.time_units))} is not a unit of the time column; give one of "
                              f"{', '.join(TIME_UNITS)}", "{time_units}")
@@ -107,6 +123,10 @@ class LogFormat:
         """No preamble, comment or delimiter given: the file is read as a plain CSV (the fast path)."""
         return self.skip_rows == 0 and self.comment is None and self.delimiter is None
 
+    def streams_given(self) -> list[str]:
+        """The options of a multi-stream log given (their field names), for a format that has one stream."""
+        return [k for k in ("topic", "stamps") if getattr(self, k) is not None]
+
     def given(self) -> list[str]:
         """The text options given (their field names), for a file type they do not apply to."""
         return [k for k in ("skip_rows", "comment", "delimiter") if getattr(self, k) not in (0, None)]
@@ -114,6 +134,9 @@ class LogFormat:
     def to_dict(self) -> dict:
         """The options as a result's ``inputs`` records them (``delimiter`` as typed words for tab and space)."""
         d = asdict(self)
+        for key in ("topic", "stamps"):  # recorded when given (a text log's inputs stay as they were)
+            if d[key] is None:
+                del d[key]
         if self.delimiter is not None:
             d["delimiter"] = {"\t": "tab", " ": "space"}.get(self.delimiter, self.delimiter)
         return d

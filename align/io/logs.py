@@ -17,17 +17,21 @@ NpyChunks, check_finite, check_readings, check_time, check_log, MAX_READING
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from align.errors import InputError, UnitError, literal
+from align.errors import InputError
 from align.io.checks import MAX_READING, check_finite, check_log, check_readings, check_repeats, check_time
 from align.io.files import existing_file
 from align.io.formats import TIME_UNITS, LogFormat, time_unit
-from align.io.tables import read_columns, shown
-from align.units import COUNT_EXAMPLES, DIMENSIONS, parse_scale, parse_unit
+from align.io.readings import celsius as _celsius
+from align.io.readings import sensor_scale
+from align.io.readings import units_of as _units_of
+from align.io.tables import read_columns, read_table, shown
 
 __all__ = ["read_sensor_log", "SensorLog", "read_log", "read_static_log", "StaticLog", "read_static", "read_columns",
            "sensor_scale", "NpyChunks", "check_finite", "check_readings", "check_time", "check_log", "MAX_READING"]
@@ -41,45 +45,6 @@ def _check_rate(rate_hz: float | None, path, missing: str = "no time column: giv
         raise InputError(f"the sample rate must be a finite number of Hz > 0, not {float(rate_hz)!r}; give e.g. "
                          "{rate_hz=100}", str(path))
     return rate_hz
-
-
-def sensor_scale(units: str, expect: str | None, field: str = "units", counts: bool = False) -> tuple[float, str]:
-    """The factor that takes a log's numbers to SI, and the unit its readings are shown in.
-
-    Parameters
-    ----------
-    units : str
-        A unit of ``expect`` (``"deg/s"``), the size of one count (``"0.0076336 deg/s"``) or a
-        datasheet sensitivity (``"131 LSB/(deg/s)"``), or ``"counts"`` (see :func:`align.units.parse_scale`).
-    expect : str or None
-        A key of :data:`align.units.DIMENSIONS` (``"angular_rate"``, ``"acceleration"``,
-        ``"magnetic_field"``, ``"counts"``); None: any unit.
-    field : str
-        The input that gave ``units``, for messages (``{gyro_units}``).
-    counts : bool
-        Whether readings may stay in raw counts; when not, ``"counts"`` is refused with the advice
-        to give the size of one count.
-
-    Returns
-    -------
-    factor : float
-        Multiplies a number of the log into SI (or counts).
-    shown : str
-        The unit results show the readings in: ``units`` itself, or for a count size the dimension's
-        unit (``deg/s``, ``m/s^2``, ``uT``).
-    """
-    where = "{" + field + "}"
-    if expect is None or expect == "counts" or expect not in COUNT_EXAMPLES:
-        return parse_unit(units, expect, where).factor, units
-    factor, unit = parse_scale(units, expect, where)
-    if not counts and parse_unit(unit).dim == DIMENSIONS["counts"][0].dim:
-        size, sensitivity, part = COUNT_EXAMPLES[expect]
-        what = DIMENSIONS[expect][1].split(",")[0]
-        why = " (a gyro's M = g/w is dimensionless only then)" if expect == "angular_rate" else ""
-        raise UnitError(f"'{literal(units)}' leaves the readings in raw counts, but they are needed as {what} here{why}; "
-                        f"give the size of one count, e.g. {{{field}={size}}} or {{{field}={sensitivity}}} for {part}",
-                        where)
-    return factor, unit
 
 
 @dataclass(frozen=True, eq=False)
@@ -104,6 +69,14 @@ class SensorLog:
         The sample rate: the median one of the time column, or the one given, Hz.
     format : LogFormat
         The preamble, comments and delimiter the file was read with.
+    temperature : ndarray, shape (n,), or None
+        The temperature column, degrees Celsius (None: not read).
+    source : mapping
+        The stream read from a log of several (topic, instance, device id; :class:`align.io.readers.Columns`).
+    notes : tuple of str
+        The reader's remarks (a truncated last record left out).
+    stated : bool
+        Whether the unit of the readings is the one the file states (not typed by the user).
     """
 
     t: np.ndarray
@@ -114,11 +87,21 @@ class SensorLog:
     time_detected: bool
     rate_hz: float
     format: LogFormat = field(default_factory=LogFormat)
+    temperature: np.ndarray | None = None
+    source: Mapping[str, Any] = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
+    stated: bool = False
 
     def inputs(self) -> dict:
         """How the file was read, for a result's ``inputs``: the format options and the time unit
-        (``time_units``, with ``time_units_detected``)."""
-        return {**self.format.to_dict(), "time_units": self.time_units, "time_units_detected": self.time_detected}
+        (``time_units``, with ``time_units_detected``), the stream read (``stream``) and the unit the file
+        states (``units_stated``), when it has them."""
+        out = {**self.format.to_dict(), "time_units": self.time_units, "time_units_detected": self.time_detected}
+        if self.source:
+            out["stream"] = dict(self.source)
+        if self.stated:
+            out["units_stated"] = self.units
+        return out
 
     def time_note(self) -> str | None:
         """One sentence on the time column's unit when it is not seconds (None otherwise): results state it."""
@@ -146,13 +129,17 @@ def _rate_only(fmt: LogFormat, path) -> None:
 def read_sensor_log(
     path: str | Path,
     columns: list[str],
-    units: str,
+    units: str | None,
     time_column: str | None = "time",
     rate_hz: float | None = None,
     expect: str | None = "angular_rate",
     log_format: LogFormat | None = None,
     counts: bool = False,
     field: str | None = None,
+    *,
+    default_units: str | None = None,
+    temperature_column: str | None = None,
+    temperature_units: str | None = None,
 ) -> SensorLog:
     """Read a sensor log: time (s) and data columns converted to SI, and how the file was read.
 
@@ -161,9 +148,11 @@ def read_sensor_log(
     path : str or Path
     columns : list of str
         The data columns, e.g. ``["gyro_x", "gyro_y", "gyro_z"]``.
-    units : str
+    units : str or None
         Unit of the data columns, e.g. ``"deg/s"``, or the size of one count (``"0.0076336 deg/s"``,
-        ``"131 LSB/(deg/s)"``); checked against ``expect`` (see :func:`sensor_scale`).
+        ``"131 LSB/(deg/s)"``); checked against ``expect`` (see :func:`sensor_scale`). None: the unit the
+        file states (a ULog, a bag), else ``default_units``. A unit given for a file that states another
+        is refused.
     time_column : str or None
         Name of the time column; None when ``rate_hz`` is given.
     rate_hz : float, optional
@@ -171,12 +160,19 @@ def read_sensor_log(
     expect : str or None
         Dimension of the readings (a key of :data:`align.units.DIMENSIONS`); None: any unit.
     log_format : LogFormat, optional
-        Preamble, comments, delimiter and the unit of the time column (detected when not given).
+        Preamble, comments, delimiter and the unit of the time column (detected when not given); the
+        topic of a log of several streams.
     counts : bool
         Whether the readings may stay in raw counts (``units="counts"``).
     field : str, optional
         The input that gave ``units``, for messages; default ``gyro_units`` for an angular rate,
         ``units`` otherwise.
+    default_units : str, optional
+        The unit when neither ``units`` nor the file gives one.
+    temperature_column : str, optional
+        A temperature column to read beside the data (``SensorLog.temperature``, degrees Celsius).
+    temperature_units : str, optional
+        Its unit (``"degC"``, ``"K"``, ``"degF"``); None: the file's, else degrees Celsius.
 
     Returns
     -------
@@ -185,22 +181,36 @@ def read_sensor_log(
     """
     fmt = log_format or LogFormat()
     field = field or ("gyro_units" if expect == "angular_rate" else "units")
-    factor, unit_shown = sensor_scale(units, expect, field, counts)
     time_col = time_column if rate_hz is None else None  # the column read as time (none with a given rate)
     use_time = time_col is not None
-    wanted = ([time_col] if time_col is not None else []) + list(columns)
+    temp = [temperature_column] if temperature_column is not None else []
+    wanted = ([time_col] if time_col is not None else []) + list(columns) + temp
     p = Path(path)
     if p.suffix.lower() == ".npy":
         _, data = read_columns(p, log_format=fmt)
         if data.shape[1] != len(wanted):
             raise InputError(f"has {data.shape[1]} columns; expected {len(wanted)} ({', '.join(map(shown, wanted))})"
                              + ("; give {rate_hz} for a file without time" if use_time else ""), str(path))
+        got = None
     else:
-        _, data = read_columns(p, wanted, time_col, fmt)
+        got = read_table(p, wanted, time_col, fmt)
+        data = got.data
+    stated = got.unit(list(columns)) if got is not None else None
+    units, from_file = _units_of(units, stated, default_units, expect, field, str(path))
+    factor, unit_shown = sensor_scale(units, expect, field, counts)
+    celsius = None
+    if temp:
+        celsius = _celsius(data[:, -1], temperature_units or (got.units.get(temperature_column) if got else None),
+                           str(path))
+        data = data[:, :-1]
+    if got is not None and time_col is not None and got.units.get(time_col) in TIME_UNITS and fmt.time_units is None:
+        fmt_time = replace(fmt, time_units=got.units[time_col])
+    else:
+        fmt_time = fmt
     if time_col is not None:
         raw_t, values = data[:, 0], data[:, 1:]
         check_readings(values, str(path), raw_t)
-        t, tu, detected = _time_of(raw_t, time_col, str(path), fmt)
+        t, tu, detected = _time_of(raw_t, time_col, str(path), fmt_time)
         step = float(np.median(np.diff(t))) if len(t) > 1 else float("nan")
         fs = 1.0 / step if step > 0 else float("nan")
     else:
@@ -208,7 +218,9 @@ def read_sensor_log(
         _rate_only(fmt, path)
         t, values, tu, detected, fs = np.arange(len(data)) / rate, data, None, False, float(rate)
         check_readings(values, str(path), t)
-    return SensorLog(np.ascontiguousarray(t), values * factor, units, unit_shown, tu, detected, fs, fmt)
+    return SensorLog(np.ascontiguousarray(t), values * factor, units, unit_shown, tu, detected, fs, fmt, celsius,
+                     dict(got.source) if got is not None else {}, tuple(got.notes) if got is not None else (),
+                     from_file)
 
 
 def read_log(

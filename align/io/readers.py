@@ -3,28 +3,102 @@
 Every command reads its logs through :func:`align.io.tables.read_columns` (and the sensor and static
 readers above it, :mod:`align.io.logs`, :mod:`align.io.source`), which asks :func:`reader_for` which
 reader holds the file. A new format is one module that defines its reader function and one
-:func:`register` call (here, for the built-in ones): ``read(path, names, time_column, log_format)
--> (names, data)`` returning float64 columns by name.
+:func:`register` call (in :func:`_builtin`): ``read(path, names, time_column, log_format)`` returning
+float64 columns by name, as ``(names, data)`` or as :class:`Columns` (which also carries the units the
+format states, the stream read and remarks such as a truncated last record).
+
+A log that holds several streams (a ROS bag's topics, a ULog's topics and instances, a DataFlash log's
+messages) is read one stream at a time, chosen by :attr:`~align.io.formats.LogFormat.topic`; its reader
+names the columns by the one convention of :class:`align.vocab.Sensor` (``gyro_x`` ..., ``accel_x``
+..., ``mag_x`` ..., ``temperature``, time as ``time`` in seconds) and states their units, so a user
+never types a unit the file already says. ``describe(path, log_format)`` lists its streams for
+``inspect``.
 
 Public names
 ------------
-LogReader, READERS, register, reader_for, formats
+LogReader, Columns, Stream, READERS, register, reader_for, formats
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from align.errors import InputError
 from align.io.formats import LogFormat
 
-__all__ = ["LogReader", "READERS", "register", "reader_for", "formats"]
+__all__ = ["LogReader", "Columns", "Stream", "READERS", "register", "reader_for", "formats"]
 
-ReadFn = Callable[[Path, "list[str] | None", "str | None", LogFormat], "tuple[list[str], np.ndarray]"]
+
+@dataclass(frozen=True, eq=False)
+class Columns:
+    """Named columns as a reader read them.
+
+    Attributes
+    ----------
+    names : list of str
+        Column names, in the order of ``data``'s columns.
+    data : ndarray, shape (n, k), float64
+    units : mapping of str to str
+        The unit the file states for a column (``{"gyro_x": "rad/s", "time": "s", "temperature": "degC"}``);
+        a column it does not name has no stated unit (a CSV states none).
+    source : mapping of str to object
+        The stream read, for a result's provenance (``{"topic": "sensor_gyro", "instance": 1,
+        "device_id": 2293768}``); empty for a single-stream file.
+    notes : tuple of str
+        Remarks a result states (``"last record truncated (12 of 40 bytes), left out"``).
+    """
+
+    names: list[str]
+    data: np.ndarray
+    units: Mapping[str, str] = field(default_factory=dict)
+    source: Mapping[str, Any] = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
+
+    @classmethod
+    def of(cls, got: Columns | tuple[list[str], np.ndarray]) -> Columns:
+        """A reader's answer as :class:`Columns` (a ``(names, data)`` pair has no units, source or notes)."""
+        return got if isinstance(got, Columns) else cls(list(got[0]), got[1])
+
+    def unit(self, names: list[str]) -> str | None:
+        """The one unit the file states for all of ``names`` (None: none stated, or not one unit)."""
+        units = {self.units.get(n) for n in names}
+        return units.pop() if len(units) == 1 else None
+
+
+@dataclass(frozen=True)
+class Stream:
+    """One stream of a log, as ``inspect`` lists it (:attr:`LogReader.describe`).
+
+    Attributes
+    ----------
+    topic : str
+        What :attr:`~align.io.formats.LogFormat.topic` selects it by (``"/imu0"``, ``"sensor_gyro:1"``, ``"IMU:0"``).
+    kind : str
+        Its message type (``"sensor_msgs/msg/Imu"``, ``"sensor_gyro"``, ``"IMU"``).
+    count : int
+        Its number of samples.
+    columns : tuple of str
+        The columns it gives, by the one convention (``gyro_x`` ...).
+    units : mapping of str to str
+        Their units as the format states them.
+    extra : mapping of str to object
+        What else the format says of it (``device_id``, a nominal rate).
+    """
+
+    topic: str
+    kind: str
+    count: int
+    columns: tuple[str, ...] = ()
+    units: Mapping[str, str] = field(default_factory=dict)
+    extra: Mapping[str, Any] = field(default_factory=dict)
+
+
+ReadFn = Callable[[Path, "list[str] | None", "str | None", LogFormat], "Columns | tuple[list[str], np.ndarray]"]
 
 
 @dataclass(frozen=True)
@@ -38,11 +112,19 @@ class LogReader:
     suffixes : tuple of str
         File endings it owns, lower case with the dot (``".csv"``, ``".csv.gz"``).
     read : callable
-        ``read(path, names, time_column, log_format) -> (names, data (n, k) float64)``.
+        ``read(path, names, time_column, log_format) -> Columns`` (or ``(names, data (n, k) float64)``).
     sniff : callable, optional
-        ``sniff(first_bytes) -> bool``: whether a file of no known suffix is of this format.
+        ``sniff(first_bytes) -> bool``: whether a file of no known suffix (or of a suffix two formats use,
+        ``.bin``) is of this format.
     text : bool
         Whether the logger's text options (preamble, comment, delimiter) apply.
+    streams : bool
+        Whether the format holds several streams (``topic`` and ``stamps`` apply).
+    describe : callable, optional
+        ``describe(path, log_format) -> list of Stream``: what the log holds (``inspect``).
+    folder : bool
+        Whether a folder is a log of this format (a ROS 2 bag, an EuRoC dataset): ``sniff`` is then
+        given the folder's file names, one per line, instead of first bytes.
     """
 
     name: str
@@ -50,6 +132,9 @@ class LogReader:
     read: ReadFn
     sniff: Callable[[bytes], bool] | None = None
     text: bool = False
+    streams: bool = False
+    describe: Callable[[Path, LogFormat], list[Stream]] | None = None
+    folder: bool = False
 
 
 #: the registered readers, in the order they are tried by content
@@ -76,17 +161,33 @@ def reader_for(path: Path, log_format: LogFormat | None = None) -> LogReader:
     InputError
         Naming the file and the formats there are.
     """
+    if path.is_dir():
+        listing = "\n".join(sorted(str(p.relative_to(path)) for p in path.rglob("*"))[:10_000]).encode()
+        for r in READERS:
+            if r.folder and r.sniff is not None and r.sniff(listing):
+                return r
+        folders = [r.name for r in READERS if r.folder]
+        raise InputError("is a folder, and not a log folder of a known kind"
+                         + (f" ({', '.join(folders)})" if folders else "") + "; give a log file", str(path))
     name = path.name.lower()
     owned = [(len(s), r) for r in READERS for s in r.suffixes if name.endswith(s)]
-    if owned:
-        return max(owned, key=lambda pair: pair[0])[1]
     try:
         with open(path, "rb") as fh:
             head = fh.read(1 << 12)
     except OSError:
         head = b""
+    if owned:
+        longest = max(n for n, _ in owned)
+        mine = [r for n, r in owned if n == longest]
+        if len(mine) == 1:
+            return mine[0]
+        for r in mine:  # one suffix, several formats (.bin): by content
+            if r.sniff is not None and r.sniff(head):
+                return r
+        raise InputError(f"is not a {' or '.join(r.name for r in mine)} file (its first bytes are neither); "
+                         "check the file", str(path))
     for r in READERS:
-        if r.sniff is not None and r.sniff(head):
+        if r.sniff is not None and not r.folder and r.sniff(head):
             return r
     raise InputError(f"unknown file type; use one of {', '.join(formats())}", str(path))
 
@@ -103,12 +204,21 @@ def _text_sniff(head: bytes) -> bool:
 
 
 def _builtin() -> None:
+    """The formats this installation reads (a new format: its module's ``READER`` added here)."""
     from align.io import tables
 
     register(LogReader("csv", (".csv", ".csv.gz", ".txt", ".txt.gz", ".tsv", ".gz"), tables.csv_columns,
                        _text_sniff, text=True))
     register(LogReader("npy", (".npy",), tables.npy_columns, lambda head: head.startswith(b"\x93NUMPY")))
     register(LogReader("parquet", (".parquet",), tables.parquet_columns, lambda head: head.startswith(b"PAR1")))
+    import importlib
+
+    for name in PLUGINS:  # the formats of their own modules, each defining READER
+        register(importlib.import_module(name).READER)
+
+
+#: modules of formats, each with a ``READER`` (:class:`LogReader`); imported when this registry is
+PLUGINS: tuple[str, ...] = ()
 
 
 _builtin()

@@ -118,9 +118,14 @@ class LogSource:
     rate_hz : float or None
         Sample rate, Hz, for a log read without its time column.
     units : str or None
-        Unit of the readings as typed (``"deg/s"``, ``"131 LSB/(deg/s)"``); None: the sensor's default.
+        Unit of the readings as typed (``"deg/s"``, ``"131 LSB/(deg/s)"``); None: the unit the file states
+        (ULog, bags, DataFlash), else the sensor's default.
     format : LogFormat
-        Preamble, comment, delimiter, time unit of a text log.
+        Preamble, comment, delimiter, time unit of a text log; the topic of a log of several streams.
+    temperature_column : str or None
+        A temperature column read beside the readings (``SensorLog.temperature``, degrees Celsius).
+    temperature_units : str or None
+        Its unit (``degC``, ``K``, ``degF``); None: the file's, else degrees Celsius.
 
     Examples
     --------
@@ -135,6 +140,8 @@ class LogSource:
     rate_hz: float | None = None
     units: str | None = None
     format: LogFormat = field(default_factory=LogFormat)
+    temperature_column: str | None = None
+    temperature_units: str | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "path", Path(self.path))
@@ -172,13 +179,18 @@ class LogSource:
         SensorLog
             ``t`` (n,) s, ``data`` (n, k) SI.
         """
-        units = self.units or sensor.unit
         expect = expect or sensor.dimension
         time, cols = self.names(sensor, defaults, columns_field)
         if self.columns is None and defaults is None:
             cols = self._defaults_present(sensor, cols, time)
-        return read_sensor_log(self.path, cols, units, time, self.rate_hz, expect=expect, log_format=self.format,
-                               counts=counts, field=field or ("gyro_units" if sensor is Sensor.GYROSCOPE else "units"))
+        if self.temperature_column is not None and self.temperature_column in cols + [time]:
+            raise InputError(f"'{literal(self.temperature_column)}' is both the temperature column and a "
+                             f"{'time' if self.temperature_column == time else 'data'} column; name each once",
+                             "{temperature_column}")
+        return read_sensor_log(self.path, cols, self.units, time, self.rate_hz, expect=expect, log_format=self.format,
+                               counts=counts, field=field or ("gyro_units" if sensor is Sensor.GYROSCOPE else "units"),
+                               default_units=sensor.unit, temperature_column=self.temperature_column,
+                               temperature_units=self.temperature_units)
 
     def data_names(self, sensor: Sensor, field: str = "columns") -> list[str]:
         """The data columns :meth:`read` reads for ``sensor``: those given, or the defaults the file holds."""
@@ -220,7 +232,9 @@ class LogSource:
         """How the source was given, for a result's ``inputs``."""
         return {"log": str(self.path), "columns": None if self.columns is None else ",".join(self.columns),
                 "time_column": self.time_column, "rate_hz": self.rate_hz, "units": self.units,
-                **self.format.to_dict()}
+                **self.format.to_dict(),
+                **({"temperature_column": self.temperature_column, "temperature_units": self.temperature_units}
+                   if self.temperature_column is not None else {})}
 
 
 def check_distinct(first: tuple[Sensor, Sequence[str], str], second: tuple[Sensor, Sequence[str], str]) -> None:

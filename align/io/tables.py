@@ -8,7 +8,7 @@ CSV reader cannot read, the likely preamble or delimiter with the option to give
 
 Public names
 ------------
-read_columns, shown
+read_columns, read_table, shown
 """
 
 from __future__ import annotations
@@ -36,22 +36,42 @@ def read_columns(path: str | Path, names: list[str] | None = None, time_column: 
     time_column : str, optional
         The name among ``names`` that is the time (a missing one then points to the sample rate).
     log_format : LogFormat, optional
-        Preamble, comments and delimiter of a text file (its ``time_units`` are not used here).
+        Preamble, comments and delimiter of a text file (its ``time_units`` are not used here); the topic
+        of a log with several streams.
 
     Returns
     -------
     names : list of str
     data : ndarray, shape (n, k), float64
     """
-    from align.io.readers import reader_for
+    got = read_table(path, names, time_column, log_format)
+    return got.names, got.data
 
-    p = existing_file(path)
+
+def read_table(path: str | Path, names: list[str] | None = None, time_column: str | None = None,
+               log_format: LogFormat | None = None):
+    """:func:`read_columns` with what the format states besides: the columns' units, the stream read and
+    remarks (:class:`align.io.readers.Columns`).
+
+    Raises
+    ------
+    InputError
+        A text option given for a binary file, a topic for a file of one stream, or the reader's refusal.
+    """
+    from align.io.readers import Columns, reader_for
+
+    p = Path(path)
+    p = p if p.is_dir() else existing_file(path)
     fmt = log_format or LogFormat()
     reader = reader_for(p, fmt)
     if not reader.text and fmt.given():
         given = ", ".join("{" + k + "}" for k in fmt.given())
-        raise InputError(f"{given} apply to text logs, not to a {p.suffix} file; leave them out", str(path))
-    return reader.read(p, names, time_column, fmt)
+        raise InputError(f"{given} apply to text logs, not to a {reader.name} file; leave them out", str(path))
+    if not reader.streams and fmt.streams_given():
+        given = ", ".join("{" + k + "}" for k in fmt.streams_given())
+        raise InputError(f"{given} apply to logs of several streams (ROS bags, ULog, DataFlash), and a "
+                         f"{reader.name} file has one; leave them out", str(path))
+    return Columns.of(reader.read(p, names, time_column, fmt))
 
 
 def parquet_columns(p: Path, names: list[str] | None, time_column: str | None, fmt: LogFormat

@@ -1,7 +1,7 @@
 """The one layout of a matrix's scale factors and misalignment angles, shared by every presentation.
 
 ``matrix``/``calibrate`` text (:func:`align.present.text.angle_lines`), the CSV export
-(:mod:`align.present.exports`) and the report's sections all lay the angles out from :func:`angle_rows`:
+(:mod:`align.present.exportable`) and the report's sections all lay the angles out from :func:`angle_rows`:
 five rows, each a label, its elements, the values in the display unit and (when ``sigma(M)`` is known)
 their 1-sigma.
 
@@ -19,7 +19,7 @@ rotation  mounting rotation     rotation vector of ``R``, ``R^T`` the    x, y, z
                                 nearest proper rotation to ``M N^T``
 ========  ====================  =======================================  ==============  ===========
 
-M's unit is :func:`align.io.export.matrix_unit` (``1`` for readings in a physical unit, ``counts per
+M's unit is :func:`align.io.consumers.matrix_unit` (``1`` for readings in a physical unit, ``counts per
 m/s^2`` etc. for readings in counts). The 1-sigma are first-order propagations of ``sigma(M)`` with the
 elements taken independent (:func:`align.present.verdicts.angle_sigmas`; for the scale,
 ``sigma_s_i^2 = sum_j (M_ij / s_i)^2 sigma_M,ij^2``).
@@ -127,7 +127,7 @@ def angle_rows(m: np.ndarray, sigma_m: np.ndarray | None = None, mounting: np.nd
     mounting : ndarray, shape (3, 3), optional
         Nominal mounting ``N`` (rows: sensor axes in the reference frame); the angles are relative to it.
     unit : str
-        M's unit (:func:`align.io.export.matrix_unit`), the scale row's unit.
+        M's unit (:func:`align.io.consumers.matrix_unit`), the scale row's unit.
     assumed : int, optional
         The axis whose scale was assumed (marked on the scale row).
 

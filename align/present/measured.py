@@ -4,7 +4,7 @@ and element by element against each element's allowance (the diagnosis), with a 
 The verdict propagates the measured misalignment, ``D = M N^T`` with its rows scaled to unit length (the
 directions of the gyro axes relative to the nominal mounting ``N``; scale-factor errors are the
 calibration's, not a misalignment), through the manoeuvre by attitude propagation
-(:func:`align.sensitivity.attitude.output_errors`), so that the errors of several elements add up as they
+(:func:`align.sensitivity.propagation.output_errors`), so that the errors of several elements add up as they
 do in flight; its 1-sigma is the first-order propagation of ``sigma(M)`` through the same computation
 (central differences, the elements taken independent). Each limited output is then judged with a guard
 band of ``k`` sigma (:func:`guard`): PASS when ``limit - error > k sigma``, FAIL when
@@ -129,7 +129,7 @@ def output_margins(m: np.ndarray, sigma_m: np.ndarray, mounting: np.ndarray | No
                    k: float = GUARD_K) -> list[OutputMargin]:
     """The measured misalignment propagated through a manoeuvre, output by output, with its 1-sigma.
 
-    ``e_o = max_t |error_o(t)|`` of :func:`~align.sensitivity.attitude.output_errors` for ``D`` = ``M N^T``
+    ``e_o = max_t |error_o(t)|`` of :func:`~align.sensitivity.propagation.output_errors` for ``D`` = ``M N^T``
     with unit rows; ``sigma_e_o^2 = sum_kl (d e_o / d M_kl)^2 sigma_M,kl^2`` (central differences, step
     1e-7; the elements taken independent, as the result states no covariance).
 
@@ -149,7 +149,7 @@ def output_margins(m: np.ndarray, sigma_m: np.ndarray, mounting: np.ndarray | No
     list of OutputMargin
         One per limited output, in the manoeuvre's order; rad.
     """
-    from align.sensitivity.attitude import output_errors
+    from align.sensitivity.propagation import output_errors
 
     n = np.eye(3) if mounting is None else np.asarray(mounting, float)
     m = np.asarray(m, float)

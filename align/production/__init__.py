@@ -35,7 +35,7 @@ from align.production.batch import (
     run_units,
     unit_rows,
 )
-from align.production.figures import FIGURES, result_rows
+from align.production.keyfigures import FIGURES, result_rows
 from align.production.manifest import Manifest, Unit, input_hash, read_manifest
 from align.production.pools import make_pool
 from align.production.rehearsal import LotSpread, LotTruth, simulate_lot

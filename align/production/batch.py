@@ -5,7 +5,7 @@ manifest row by the command's own parser and options builder; its result file; i
 worker through a pool (:mod:`align.production.pools`). The worker (:func:`run_job`) calls the library
 job (``align.api.job(name).run(options)``), writes the JSON result and the extra files the unit's output
 options ask for (all or none, :class:`align.io.outputs.Outputs`) and returns the table rows made from the
-result in memory (:func:`align.production.figures.result_rows`). The rows are appended to the lot's table
+result in memory (:func:`align.production.keyfigures.result_rows`). The rows are appended to the lot's table
 through a journal (:class:`align.production.table.Journal`): per unit as it finishes, so that a killed
 batch keeps what was done.
 
@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from align.errors import AlignError, InputError
-from align.production.figures import result_rows
+from align.production.keyfigures import result_rows
 from align.production.manifest import Unit, input_hash
 from align.production.table import Journal, latest_rows, now, read_table
 
@@ -144,7 +144,7 @@ def error_rows(task: Task, status: str, exit_code: int, message: str, digest: st
 
 def result_unit_rows(task: Task, result, message: str, digest: str, seconds: float) -> list[dict]:
     """The rows of a unit whose job gave ``result`` (in memory): one per sensor with its figures
-    (:func:`align.production.figures.result_rows`), status ``"ok"``."""
+    (:func:`align.production.keyfigures.result_rows`), status ``"ok"``."""
     stamp = now()
     found = result_rows(result) if result is not None else []
     return [{**_base(task), "time": stamp, "status": "ok", "exit_code": 0, "message": message, "input_hash": digest,

@@ -14,7 +14,7 @@ six-dwell rate-table test (+/- ``rate`` about x, y, z) simulated by
 Written into ``folder``: ``plan.toml``, ``sessions/SERIAL.csv`` (time in s, gyro columns in
 deg/s), ``manifest.csv`` (job ``matrix``) and ``truth.csv``: per unit its serial, order, slot,
 kind (``good`` or the bad kind), the true ``M_ij`` and ``bias_i`` (rad/s) and the figures of ``M``
-(:mod:`align.production.figures`, SI). ``truth.csv``'s first line is a comment (``#``) stating its
+(:mod:`align.production.keyfigures`, SI). ``truth.csv``'s first line is a comment (``#``) stating its
 format, version, the imu-align version, the convention and every column's unit (:data:`TRUTH_HEADER`);
 :func:`read_truth` reads it back and checks it.
 
@@ -38,7 +38,7 @@ from align.alignment.simulate import SessionSpec, simulate_run
 from align.errors import InputError
 from align.io.files import write_csv, write_text
 from align.model import SensorModel
-from align.production.figures import matrix_figures
+from align.production.keyfigures import matrix_figures
 from align.units import DEG, DEG_S, to_unit
 
 #: the kinds of deliberately bad units, in the order :func:`simulate_lot` hands them out

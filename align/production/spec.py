@@ -34,7 +34,7 @@ from pathlib import Path
 
 from align.errors import InputError, literal
 from align.io.files import read_toml
-from align.production.figures import FIGURES, KIND, shown_unit, si_unit
+from align.production.keyfigures import FIGURES, KIND, shown_unit, si_unit
 from align.units import parse_unit, to_unit
 
 #: the sensors a row may be of, and a spec table may be named after

@@ -39,7 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from align.production.figures import FIGURES, KIND, shown_unit, si_unit
+from align.production.keyfigures import FIGURES, KIND, shown_unit, si_unit
 from align.production.spec import Limit, Spec
 from align.units import to_unit
 

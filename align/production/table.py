@@ -14,7 +14,7 @@ batch loses at most the units that were running.
 
 Columns: :data:`META` (serial, slot, order, run, time (UTC), job, sensor, status, exit_code,
 message, verdict, checks, input_hash, result, seconds, worker, bias_unit), then every figure of
-:data:`align.production.figures.FIGURES` (float64, SI; each field's metadata holds its unit).
+:data:`align.production.keyfigures.FIGURES` (float64, SI; each field's metadata holds its unit).
 
 Public names
 ------------
@@ -35,7 +35,7 @@ import pyarrow.parquet as pq
 
 from align.errors import InputError
 from align.io.files import write_bytes
-from align.production.figures import FIGURES, KIND, si_unit
+from align.production.keyfigures import FIGURES, KIND, si_unit
 
 #: the non-figure columns, in order, with their Arrow types
 META: tuple[tuple[str, pa.DataType], ...] = (

@@ -19,9 +19,9 @@ Allowable, allowable (from ``allowable``); Margin, margins, MarginTable, check_m
 """
 
 from align.sensitivity.allowable import Allowable, allowable
-from align.sensitivity.attitude import closed_form_errors, output_errors
 from align.sensitivity.manoeuvre import Manoeuvre, manoeuvre_from_dict
 from align.sensitivity.margins import Margin, MarginTable, check_margins, margins
+from align.sensitivity.propagation import closed_form_errors, output_errors
 from align.sensitivity.symbolic import ELEMENTS, OUTPUTS, matrix_from_angles, response, sensitivity, symbolic, symbolic_text
 
 __all__ = ["ELEMENTS", "OUTPUTS", "symbolic", "symbolic_text", "matrix_from_angles", "response", "sensitivity",

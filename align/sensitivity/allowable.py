@@ -4,7 +4,7 @@ Each of the nine elements of ``M`` (Eq 5-10) is raised alone until some output
 of the manoeuvre reaches its limit: by Example 2's closed forms
 ``phi_max = asin(E / Theta)`` and ``psi_max = acos(1 - E / Theta)`` (Eq 11-13)
 where they apply, otherwise by root finding on attitude propagation
-(:mod:`align.sensitivity.attitude`). The smallest is the binding element; the
+(:mod:`align.sensitivity.propagation`). The smallest is the binding element; the
 cone is the largest rigid mounting rotation, in any direction, that meets every
 limit.
 
@@ -28,8 +28,8 @@ import numpy as np
 from align import CONVENTION
 from align.errors import InputError
 from align.results import Result
-from align.sensitivity.attitude import closed_form_errors, output_errors
 from align.sensitivity.manoeuvre import Manoeuvre
+from align.sensitivity.propagation import closed_form_errors, output_errors
 from align.sensitivity.symbolic import ELEMENTS, matrix_from_angles
 from align.units import DEG
 

@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 from support import truth_model
 
-from align.alignment.drift import estimate_drift, with_drift
+from align.alignment.biasdrift import estimate_drift, with_drift
 from align.alignment.estimate import fit_angle_pairs, fit_lsq, fit_rate_pairs
 from align.alignment.job import AlignOptions, align
 from align.alignment.observe import observe

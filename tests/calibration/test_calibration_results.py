@@ -9,7 +9,7 @@ from magsim import F, capture, truth
 from align.calibration import Calibration, CalibrationSet, MagCalibration, calibrate_magnetometer
 from align.calibration.results import CONVENTION
 from align.errors import InputError
-from align.io.export import imucal_dict
+from align.io.consumers import imucal_dict
 from align.results import load_result, result_from_dict, save_result
 from align.values import approx_equal
 

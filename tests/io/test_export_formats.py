@@ -1,4 +1,4 @@
-"""The export writers (align.io.export) read back by their consumers: a C compiler, PyYAML, pandas."""
+"""The export writers (align.io.consumers) read back by their consumers: a C compiler, PyYAML, pandas."""
 
 import shutil
 import subprocess
@@ -9,7 +9,7 @@ import pytest
 import yaml
 
 from align.errors import InputError
-from align.io.export import c_array, c_file, c_float, csv_text, kalibr_yaml, lower_rotation, matrix_unit, yaml_float
+from align.io.consumers import c_array, c_file, c_float, csv_text, kalibr_yaml, lower_rotation, matrix_unit, yaml_float
 
 CC = shutil.which("cc")
 #: pandas before 3 parses floats with a fast, inexact parser unless asked; 3 deprecates the option (exact by default)

@@ -1,6 +1,6 @@
 """The measured misalignment's verdict: propagated through the manoeuvre (errors of several elements add), its
 1-sigma by the same propagation, and the guard band. The truth is an attitude computation written here with scipy's
-rotations (one rotation composed after another, in the body frame), independent of align.sensitivity.attitude."""
+rotations (one rotation composed after another, in the body frame), independent of align.sensitivity.propagation."""
 
 import numpy as np
 import pytest

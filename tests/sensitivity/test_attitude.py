@@ -3,8 +3,8 @@
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from align.sensitivity.attitude import attitudes, closed_form_errors, output_errors
 from align.sensitivity.manoeuvre import manoeuvre_from_dict
+from align.sensitivity.propagation import attitudes, closed_form_errors, output_errors
 from align.sensitivity.symbolic import matrix_from_angles
 from align.units import DEG
 

@@ -1,11 +1,11 @@
-"""The bias-drift model (align.alignment.drift) against analytic cases and simulated random walks and flicker."""
+"""The bias-drift model (align.alignment.biasdrift) against analytic cases and simulated random walks and flicker."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from align.alignment.drift import Drift, DriftObservation, estimate_drift, interval_means, with_drift
+from align.alignment.biasdrift import Drift, DriftObservation, estimate_drift, interval_means, with_drift
 from align.alignment.estimate import fit_angle_pairs, fit_rate_pairs
 from align.alignment.observe import Observation
 from align.alignment.plan import Plan

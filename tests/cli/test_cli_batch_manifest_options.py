@@ -1,4 +1,4 @@
-"""Review 17's batch findings through the command line: one serial with several jobs (a result file per job),
+"""The batch through the command line: one serial with several jobs (a result file per job),
 options checked against the job's command when the manifest is read, --axis-down's files resolved and hashed,
 --rerun, a foreign table and a bad scheduler address as one line."""
 
