@@ -201,7 +201,8 @@ def fit_noise(res: AllanResult, channel: int, min_edf: float = 2.0, where: str |
     needed, notes = np.full(5, np.nan), []
     edf_all, dominant = _point_edf(res, channel, p)
     for k in np.flatnonzero(~ident).tolist():
-        upper[k] = _upper(k, p, tau[use], avar[use], edf_all[use])
+        edf_k = edf_all[use] if res.runs <= 1 else np.minimum(edf_all[use], _term_edf(res, k, use))
+        upper[k] = _upper(k, p, tau[use], avar[use], edf_k)
         needed[k], here = _needed(k, upper[k], p, res)
         notes.append(_note(k, p[k], share[k], rel[k], needed[k], res, here))
     lo, hi = confidence_interval(adev, edf)  # the channel's EDF: the result's own (per-tau identification)
@@ -209,6 +210,17 @@ def fit_noise(res: AllanResult, channel: int, min_edf: float = 2.0, where: str |
                               params)
     return NoiseFit(params, sigma, tuple(bool(i) for i in ident), tuple(notes), dominant, edf_all, lo, hi, readouts,
                     cov, upper, needed, pvalues=gls.pvalues[:5].copy())
+
+
+def _term_edf(res: AllanResult, k: int, use: np.ndarray) -> np.ndarray:
+    """EDF of the points ``use`` were term ``k`` the noise there (SP 1065 Table 5 with its alpha), times the runs
+    pooled: the bound asks "could term ``k`` be this large?", and where it would dominate its points have its
+    (fewer) degrees of freedom, not the sum of what each run's identification found there (that sum made the
+    pooled bound of a rate random walk too tight: below the truth in 6 of 39 lots,
+    tests/noise/test_pooled_bound_coverage.py). A single run keeps its own EDF, whose bounds cover
+    (tests/noise/test_fit_coverage.py)."""
+    m = np.asarray(res.m, dtype=float)[use]
+    return edf_overlapping(res.n_phase, m, np.full(len(m), NOISE_ALPHA[TERMS[k]])) * max(int(res.runs), 1)
 
 
 def _upper(k: int, p: np.ndarray, tau: np.ndarray, avar: np.ndarray, edf: np.ndarray) -> float:
