@@ -8,6 +8,7 @@ identify  per-tau noise identification (lag-1 autocorrelation, B1 ratio) and the
 covariance covariance of overlapping Allan variances of a noise model (the fit's weights)
 fit       whole-model noise fit (generalised least squares), upper bounds, the seed's noise figures
 gls       generalised least squares of the Allan variance on the model, with profile intervals (the fit's core)
+periodic  a periodic disturbance's Allan signature (IEEE Std 952 Annex C), scanned and tested beside the terms
 readouts  IEEE point readouts (N at tau = 1 s, floor, K at tau = 3 s) with their intervals
 sim       sensor-error simulator and the seed's three error models
 planner   averaging time and test plan (reference Example 3); result ``imu-align.plan``

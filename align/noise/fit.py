@@ -44,6 +44,7 @@ from align.noise.allan import AllanResult, confidence_interval, edf_overlapping,
 from align.noise.covariance import avar_covariance, avar_covariance_basis
 from align.noise.gls import FALSE_ALARM, GlsFit, nnls_small, scaled_nnls, whitener
 from align.noise.model import NOISE_ALPHA, TERMS, NoiseModel, avar_design, model_adev
+from align.noise import periodic
 from align.noise.readouts import point_readouts
 from align.values import Value
 
@@ -53,7 +54,7 @@ __all__ = ["NoiseFit", "fit_noise", "point_readouts", "noise_figures", "nnls_sma
 FIT_METHOD = ("generalised least squares on the overlapping Allan variance with its covariance from the fitted "
               "model (IEEE 952 five-term model, non-negative squared terms)")
 #: most curve points the fit uses (log-spaced, the longest tau always among them)
-FIT_POINTS = 16
+FIT_POINTS = 32
 #: refits with the covariance of the previous fit
 ITERATIONS = 3
 #: one-sided level of each point's bound behind them (the minimum over several points: about 95 % overall)
@@ -97,6 +98,9 @@ class NoiseFit(Value):
     false_alarm : float
         The stated chance that a record lacking a term gets it claimed, over all terms tried
         (:data:`align.noise.gls.FALSE_ALARM`).
+    periodic : ndarray, shape (2,)
+        A periodic disturbance the test claims (:mod:`align.noise.periodic`): period (s) and amplitude (SI);
+        NaN when none. Modelled apart from the five terms.
     """
 
     params: np.ndarray
@@ -114,6 +118,7 @@ class NoiseFit(Value):
     method: str = FIT_METHOD
     pvalues: np.ndarray = field(default_factory=lambda: np.ones(5))
     false_alarm: float = FALSE_ALARM
+    periodic: np.ndarray = field(default_factory=lambda: np.full(2, np.nan))
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -188,9 +193,24 @@ def fit_noise(res: AllanResult, channel: int, min_edf: float = 2.0, where: str |
     use = np.flatnonzero((edf >= min_edf) & (avar > 0))
     pick = use[np.unique(np.round(np.linspace(0, len(use) - 1, min(FIT_POINTS, len(use)))).astype(int))]
     a, y = avar_design(tau[pick]), avar[pick]
-    gls = GlsFit(a, y, avar_covariance_basis(res.m[pick], res.n_phase, res.fs, ramp=True) / res.runs,
-                 2 * np.maximum(a @ p, y) ** 2 / np.maximum(edf[pick], 1.0))
+    basis = avar_covariance_basis(res.m[pick], res.n_phase, res.fs, ramp=True) / res.runs
+    fallback = 2 * np.maximum(a @ p, y) ** 2 / np.maximum(edf[pick], 1.0)
+    gls = GlsFit(a, y, basis, fallback)
+    period, periodic_note = float("nan"), []
+    if len(pick) > 7:  # a sixth column: the period whose signature best fits what the terms leave (align.noise.periodic)
+        q = gls._iterate(p, ITERATIONS)
+        wh = gls.wh(q)
+        period, _, count = periodic.scan(tau[pick], wh @ (y - a @ q), wh)
+        if np.isfinite(period):
+            a6 = np.column_stack([a, periodic.signature(tau[pick], period)])
+            gls = GlsFit(a6, y, basis, fallback, scan=np.r_[np.ones(5), count])
+            p = np.r_[q, 0.0]
     p, cov, _ = gls.solve(p, ITERATIONS)
+    wave = np.array([period, np.sqrt(p[5])]) if len(p) > 5 and gls.claimed[5] else np.full(2, np.nan)
+    if len(p) > 5:
+        if np.isfinite(wave[1]):
+            periodic_note.append(periodic.note(*wave))
+        p, cov = p[:5], cov[:5, :5]
     params = np.sqrt(p)
     upper = np.full(5, np.nan)
     sigma = np.where(p > 0, np.sqrt(np.abs(np.diag(cov))) / (2 * np.where(params > 0, params, 1.0)), np.nan)
@@ -208,8 +228,8 @@ def fit_noise(res: AllanResult, channel: int, min_edf: float = 2.0, where: str |
     lo, hi = confidence_interval(adev, edf)  # the channel's EDF: the result's own (per-tau identification)
     readouts = point_readouts(tau, adev, edf_all, lambda idx: avar_covariance(res.m[idx], res.n_phase, res.fs, params) / res.runs,
                               params)
-    return NoiseFit(params, sigma, tuple(bool(i) for i in ident), tuple(notes), dominant, edf_all, lo, hi, readouts,
-                    cov, upper, needed, pvalues=gls.pvalues[:5].copy())
+    return NoiseFit(params, sigma, tuple(bool(i) for i in ident), tuple(periodic_note + notes), dominant, edf_all, lo,
+                    hi, readouts, cov, upper, needed, pvalues=gls.pvalues[:5].copy(), periodic=wave)
 
 
 def _term_edf(res: AllanResult, k: int, use: np.ndarray) -> np.ndarray:
