@@ -162,7 +162,8 @@ def reader_for(path: Path, log_format: LogFormat | None = None) -> LogReader:
         Naming the file and the formats there are.
     """
     if path.is_dir():
-        listing = "\n".join(sorted(str(p.relative_to(path)) for p in path.rglob("*"))[:10_000]).encode()
+        names = sorted((str(p.relative_to(path)) for p in path.rglob("*")), key=lambda n: (n.count("/") > 2, n))
+        listing = "\n".join(names[:10_000]).encode()  # the shallow names first (a dataset's images are deep)
         for r in READERS:
             if r.folder and r.sniff is not None and r.sniff(listing):
                 return r
@@ -218,7 +219,7 @@ def _builtin() -> None:
 
 
 #: modules of formats, each with a ``READER`` (:class:`LogReader`); imported when this registry is
-PLUGINS: tuple[str, ...] = ()
+PLUGINS: tuple[str, ...] = ("align.io.dataflash", "align.io.rosbag", "align.io.euroc")
 
 
 _builtin()
