@@ -219,7 +219,7 @@ def _builtin() -> None:
 
 
 #: modules of formats, each with a ``READER`` (:class:`LogReader`); imported when this registry is
-PLUGINS: tuple[str, ...] = ("align.io.dataflash", "align.io.rosbag", "align.io.euroc")
+PLUGINS: tuple[str, ...] = ("align.io.ulog", "align.io.dataflash", "align.io.rosbag", "align.io.euroc")
 
 
 _builtin()
