@@ -16,7 +16,7 @@ never types a unit the file already says. ``describe(path, log_format)`` lists i
 
 Public names
 ------------
-LogReader, Columns, Stream, READERS, register, reader_for, formats
+LogReader, Columns, Stream, READERS, PLUGINS, register, reader_for, formats, all_readers
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ import numpy as np
 from align.errors import InputError
 from align.io.formats import LogFormat
 
-__all__ = ["LogReader", "Columns", "Stream", "READERS", "register", "reader_for", "formats"]
+__all__ = ["LogReader", "Columns", "Stream", "READERS", "PLUGINS", "register", "reader_for", "formats", "all_readers"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -149,7 +149,23 @@ def register(reader: LogReader) -> LogReader:
 
 def formats() -> list[str]:
     """Every suffix a reader owns, for messages (``.csv, .csv.gz, ...``)."""
-    return [s for r in READERS for s in r.suffixes]
+    return [s for r in all_readers() for s in r.suffixes]
+
+
+def all_readers() -> list[LogReader]:
+    """Every reader of this installation, the plugins' imported (:data:`PLUGINS`)."""
+    _load(PLUGINS)
+    return list(READERS)
+
+
+def _load(names) -> None:
+    """Import the plugin modules ``names`` not imported yet and register their ``READER``."""
+    import importlib
+
+    for name in names:
+        if name not in _LOADED:
+            _LOADED.add(name)
+            register(importlib.import_module(name).READER)
 
 
 def reader_for(path: Path, log_format: LogFormat | None = None) -> LogReader:
@@ -161,6 +177,10 @@ def reader_for(path: Path, log_format: LogFormat | None = None) -> LogReader:
     InputError
         Naming the file and the formats there are.
     """
+    name = path.name.lower()
+    _load([m for m, suffixes in PLUGINS.items() if any(name.endswith(x) for x in suffixes)])
+    if path.is_dir() or not any(name.endswith(x) for r in READERS for x in r.suffixes):
+        _load(PLUGINS)  # by content, or a folder: every format asked
     if path.is_dir():
         names = sorted((str(p.relative_to(path)) for p in path.rglob("*")), key=lambda n: (n.count("/") > 2, n))
         listing = "\n".join(names[:10_000]).encode()  # the shallow names first (a dataset's images are deep)
@@ -170,7 +190,6 @@ def reader_for(path: Path, log_format: LogFormat | None = None) -> LogReader:
         folders = [r.name for r in READERS if r.folder]
         raise InputError("is a folder, and not a log folder of a known kind"
                          + (f" ({', '.join(folders)})" if folders else "") + "; give a log file", str(path))
-    name = path.name.lower()
     owned = [(len(s), r) for r in READERS for s in r.suffixes if name.endswith(s)]
     try:
         with open(path, "rb") as fh:
@@ -212,14 +231,14 @@ def _builtin() -> None:
                        _text_sniff, text=True))
     register(LogReader("npy", (".npy",), tables.npy_columns, lambda head: head.startswith(b"\x93NUMPY")))
     register(LogReader("parquet", (".parquet",), tables.parquet_columns, lambda head: head.startswith(b"PAR1")))
-    import importlib
-
-    for name in PLUGINS:  # the formats of their own modules, each defining READER
-        register(importlib.import_module(name).READER)
 
 
-#: modules of formats, each with a ``READER`` (:class:`LogReader`); imported when this registry is
-PLUGINS: tuple[str, ...] = ("align.io.ulog", "align.io.dataflash", "align.io.rosbag", "align.io.euroc")
+#: modules of formats, each defining ``READER`` (:class:`LogReader`), with the suffixes it owns: a module is
+#: imported when a file of its suffix is read, or when a file or folder is told by its content (a CSV never
+#: imports them: the command line's start-up stays as it was)
+PLUGINS: dict[str, tuple[str, ...]] = {"align.io.ulog": (".ulg",), "align.io.dataflash": (".bin",),
+                                       "align.io.rosbag": (".bag", ".db3", ".mcap"), "align.io.euroc": ()}
+_LOADED: set[str] = set()
 
 
 _builtin()
