@@ -1,7 +1,7 @@
 """Exports: results in the formats other programs load (firmware C headers, Kalibr's imu.yaml, CSV, imucal's JSON).
 
 The writers here take plain arrays and numbers (SI unless a unit is named) and
-return text; :mod:`align.present.exports` picks what each result writes. Every
+return text; :mod:`align.present.exportable` picks what each result writes. Every
 file states its convention (correcting ``w = A (g - b)`` or modelling
 ``g = M w + b``), its frame, its units and the tool version.
 
@@ -24,7 +24,8 @@ file states its convention (correcting ``w = A (g - b)`` or modelling
 
 Public names
 ------------
-c_float, c_array, c_file, c_header, kalibr_yaml, yaml_float, lower_rotation, csv_text, matrix_unit, imucal_dict
+c_float, float32_value, FLT_MAX, c_array, c_file, c_header, kalibr_yaml, yaml_float, lower_rotation, csv_text,
+matrix_unit, imucal_dict
 """
 
 from __future__ import annotations
@@ -51,12 +52,44 @@ def c_float(x: float, where: str = "value") -> str:
     ``1.0`` -> ``1.0f``; ``1e-5`` -> ``9.99999975e-06f``. Non-finite values are refused (a C literal cannot hold
     them portably).
     """
-    if not math.isfinite(float(x)):
-        raise InputError(f"holds a non-finite value ({x}); a C header cannot carry it", where)
-    text = f"{float(np.float32(x)):.9g}"
+    text = f"{float32_value(x, where, 'a C header'):.9g}"
     if not any(c in text for c in ".eE"):
         text += ".0"
     return text + "f"
+
+
+#: the largest finite IEEE single (FLT_MAX of C's float.h)
+FLT_MAX = float(np.finfo(np.float32).max)
+
+
+def float32_value(x: float, where: str = "value", what: str = "a C float") -> float:
+    """``x`` rounded to the nearest IEEE single (a C ``float``), refusing what a float cannot hold.
+
+    Refused: a non-finite value, a value beyond ``FLT_MAX`` (3.40282347e+38: the literal would overflow to
+    infinity, or be read as something else), and a value other than zero that rounds to ``0.0`` (below half the
+    smallest subnormal, 1.4e-45): never written as a number it is not.
+
+    Examples
+    --------
+    >>> float32_value(0.1)
+    0.10000000149011612
+    >>> float32_value(1e300, "bias")
+    Traceback (most recent call last):
+    ...
+    align.errors.InputError: bias: holds 1e+300, beyond the range of a C float (|x| <= 3.40282347e+38): ...
+    """
+    v = float(x)
+    if not math.isfinite(v):
+        raise InputError(f"holds a non-finite value ({v}); {what} cannot carry it", where)
+    with np.errstate(over="ignore", under="ignore"):
+        f = float(np.float32(v))
+    if not math.isfinite(f):  # beyond FLT_MAX by more than half a float step: the literal overflows
+        raise InputError(f"holds {v:.9g}, beyond the range of a C float (|x| <= {FLT_MAX:.9g}): {what} cannot carry "
+                         "it; fix the value in the result (or regenerate the result)", where)
+    if f == 0.0 and v != 0.0:
+        raise InputError(f"holds {v:.9g}, below the smallest C float (1.4e-45): {what} would write it as 0.0; fix "
+                         "the value in the result", where)
+    return f
 
 
 def c_array(name: str, values, comment: str, where: str = "value") -> list[str]:

@@ -38,7 +38,7 @@ def signature(tau: np.ndarray, period: float) -> np.ndarray:
     --------
     >>> import numpy as np
     >>> float(np.round(signature(np.array([0.371 * 500.0]), 500.0)[0], 3))
-    0.524
+    0.525
     """
     x = np.pi * np.asarray(tau, dtype=float) / period
     return (np.sin(x) ** 2 / x) ** 2

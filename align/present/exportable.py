@@ -1,18 +1,24 @@
-"""What each result exports: Kalibr's imu.yaml, a C header, CSV tables, imucal's JSON (``imu-align export``).
+"""What each result exports: Kalibr's imu.yaml, the noise keys of OpenVINS, VINS-Fusion, PX4 and ArduPilot, a C
+header, CSV tables, imucal's JSON (``imu-align export``).
 
-The writers are :mod:`align.io.consumers`'s; here each result type is mapped to what it can export, every
-file's statement (convention, frame, units, tool, source) is composed, and a result that has no such
-export is refused with the list of those that do.
+The writers are :mod:`align.io.consumers`'s and :mod:`align.io.noise_consumers`'s; here each result type is mapped
+to what it can export, every file's statement (convention, frame, units, tool, source) is composed, and a result
+that has no such export is refused with the list of those that do.
 
-* ``allan``: kalibr (noise densities, bias random walks, update rate), csv (the curve);
-* ``alignment``: kalibr (gyroscope intrinsics), c (``A``, bias: the header ``matrix`` writes), csv (M, A, angles);
-* ``calibration``: kalibr (accelerometer and gyroscope intrinsics), c (``A``, bias, ``K_ga`` per sensor), csv,
-  imucal (with both sensors);
+* ``allan``: kalibr, openvins, vins, px4, ardupilot (noise figures in each one's terms:
+  :mod:`align.present.noise_figures`), csv (the curve);
+* ``alignment``: kalibr (gyroscope intrinsics, with Allan results for the noise keys), c (``A``, bias: the header
+  ``matrix`` writes), csv (M, A, angles);
+* ``calibration``: kalibr (accelerometer and gyroscope intrinsics, with Allan results), c (``A``, bias, ``K_ga`` per
+  sensor), csv, imucal (with both sensors);
 * ``magnetometer``: c (``A``, hard iron; soft iron and rotation when found), csv.
+
+A result whose ``A`` is not ``M^-1`` (a hand-edited file) is refused, naming the field
+(:mod:`align.present.exportchecks`).
 
 Public names
 ------------
-export_text, EXPORTS
+export, export_text, EXPORTS, NOISE
 """
 
 from __future__ import annotations
@@ -25,21 +31,28 @@ import numpy as np
 from align.alignment.result import AlignmentResult
 from align.calibration.magnetometer import MagCalibration
 from align.calibration.results import CalibrationSet
-from align.errors import InputError
+from align.errors import InputError, literal
 from align.io.consumers import TOOL, c_array, c_file, csv_text, kalibr_yaml, lower_rotation, matrix_unit
+from align.io.noise_consumers import CONSUMERS, entries, header_lines
 from align.noise.job import AllanJob
+from align.parts import Part
 from align.present.angles import DEFINITIONS, angle_rows
+from align.present.exportchecks import c_values, check_inverse
+from align.present.noise_figures import Exported, consumer_rate, gather, noise_export, noise_summary, select
 from align.results import Result
 from align.units import to_unit
 
+#: the noise consumers other than Kalibr (Allan results and a datasheet in, their noise keys out)
+NOISE = ("openvins", "vins", "px4", "ardupilot")
 #: the exports, and the result formats each one takes
 EXPORTS: dict[str, tuple[str, ...]] = {
     "kalibr": ("imu-align.allan", "imu-align.alignment", "imu-align.calibration"),
+    **{n: ("imu-align.allan",) for n in NOISE},
     "c": ("imu-align.alignment", "imu-align.calibration", "imu-align.magnetometer"),
     "csv": ("imu-align.allan", "imu-align.alignment", "imu-align.calibration", "imu-align.magnetometer"),
     "imucal": ("imu-align.calibration",),
 }
-_SHORT = {"kalibr": "Kalibr imu.yaml", "c": "C header", "csv": "CSV table", "imucal": "imucal JSON"}
+_SHORT = {"c": "C header", "csv": "CSV table", "imucal": "imucal JSON", **{n: c.title for n, c in CONSUMERS.items()}}
 _KEY = {"accelerometer": "ACCEL", "gyroscope": "GYRO"}
 _CAL_FRAME = "the axes of the calibration positions (the fixture's frame)"
 _ALIGN_FRAME = "the system frame of the test (the rate table's axes)"
@@ -201,32 +214,6 @@ def _allan_csv(job: AllanJob, where: str) -> str:
 
 # ---------------------------------------------------------------- Kalibr
 
-def _noise(job: AllanJob, k: int) -> tuple[float, str] | None:
-    """The largest over the channels of term ``k`` (1: N, 3: K), SI, and what it is.
-
-    A channel whose record identifies the term gives its fitted value; one that does not gives the term's
-    one-sided 95 % upper bound (the fit's value there is zero, which Kalibr cannot take). The comment says
-    explicitly when the number written is an upper bound, and of which channels.
-    """
-    vals, bounded = [], []
-    for name, f in zip(job.result.names, job.fits):
-        if f.identifiable[k] and np.isfinite(f.params[k]) and f.params[k] > 0:
-            vals.append((float(f.params[k]), False, name))
-        elif np.isfinite(f.upper[k]) and f.upper[k] > 0:
-            vals.append((float(f.upper[k]), True, name))
-            bounded.append(name)
-    if not vals:
-        return None
-    value, is_bound, name = max(vals)
-    if is_bound:
-        how = (f"95 % UPPER BOUND, not a fitted value: the record does not identify it ({', '.join(bounded)}; the "
-               f"fit gives 0 there); the largest over the axes, from {name}")
-    else:
-        how = f"fitted, the largest over the axes ({name})" + (
-            f"; a 95 % upper bound stands in for {', '.join(bounded)}, not identified" if bounded else "")
-    return value, how
-
-
 def _flat(m: np.ndarray) -> str:
     return "[" + ", ".join("[" + ", ".join(f"{v:.9g}" for v in row) + "]" for row in m) + "]"
 
@@ -262,46 +249,39 @@ def _kalibr_intrinsics(r: Result, where: str) -> tuple[dict, str]:
     return out, note
 
 
-def _kalibr(results: list[tuple[Result, str]], rostopic: str) -> str:
-    noise: dict[str, tuple[AllanJob, str]] = {}
+def _kalibr(results: list[tuple[Result, str]], rostopic: str, inflate: float, rate_hz: float | None,
+            part: Part | None, floor_tau: float | None) -> Exported:
+    allan: list[tuple[AllanJob, str]] = []
     intrinsics: tuple[Result, str] | None = None
     for r, where in results:
         if isinstance(r, AllanJob):
-            if r.sensor in noise:
-                raise InputError(f"a second {r.sensor} Allan result (the first: {noise[r.sensor][1]}); give one per "
-                                 "sensor", where)
-            noise[r.sensor] = (r, where)
+            allan.append((r, where))
         elif isinstance(r, (AlignmentResult, CalibrationSet)):
             if intrinsics is not None:
                 raise InputError(f"a second alignment or calibration (the first: {intrinsics[1]}); give one", where)
             intrinsics = (r, where)
         else:
             raise _refuse(r, "kalibr", where)
-    scalars: list[tuple[str, str | float, str]] = [("rostopic", rostopic, "")]
-    rates = {float(j.result.fs) for j, _ in noise.values()}
-    if len(rates) > 1:
-        raise InputError(f"the Allan results were sampled at different rates ({', '.join(f'{x:g}' for x in sorted(rates))}"
-                         " Hz); Kalibr's update_rate is one", noise["accelerometer"][1])
-    missing = []
-    if rates:
-        scalars.append(("update_rate", rates.pop(), "Hz, the sample rate of the Allan record"))
-    else:
-        missing.append("update_rate")
-    for sensor, prefix, units in (("accelerometer", "accelerometer", ("m/s^2/sqrt(Hz)", "m/s^3/sqrt(Hz)")),
-                                  ("gyroscope", "gyroscope", ("rad/s/sqrt(Hz)", "rad/s^2/sqrt(Hz)"))):
-        for k, key, unit, what in ((1, "noise_density", units[0], "white noise N"),
-                                   (3, "random_walk", units[1], "bias random walk K")):
-            got = _noise(noise[sensor][0], k) if sensor in noise else None
-            if got is None:
-                missing.append(f"{prefix}_{key}")
-            else:
-                scalars.append((f"{prefix}_{key}", got[0], f"{unit}, {what} (Allan fit, IEEE 952): {got[1]}"))
+    first = results[0][1]
     sensors, frame = ({}, "IMU frame i = the sensor axes of the Allan records") if intrinsics is None else \
-        _kalibr_intrinsics(*intrinsics)
-    srcs = "; ".join(f"{Path(w).name} ({r.FORMAT})" for r, w in results)
-    header = [f"Kalibr imu.yaml (ImuParameters keys; nest it under imu0: for an IMU chain) written by {TOOL}",
-              f"from: {srcs}",
-              "units: SI (continuous-time noise densities and bias random walks, Kalibr's IMU noise model)"]
+        _kalibr_intrinsics(*intrinsics)  # a matrix Kalibr cannot take is named first
+    if not allan and part is None:
+        raise InputError(f"holds an {results[0][0].FORMAT} result, which has no noise figures: Kalibr's imu.yaml needs "
+                         "gyroscope_noise_density, gyroscope_random_walk, accelerometer_noise_density and "
+                         "accelerometer_random_walk; give the allan result of each sensor together with it", first)
+    consumer = CONSUMERS["kalibr"]
+    figs = gather(allan, part, floor_tau)
+    got, _ = select(consumer, figs, first)
+    f, how = consumer_rate(consumer, figs, rate_hz, first)
+    if f is None:
+        raise InputError("Kalibr's update_rate is the IMU's rate and no Allan record gives it; give it "
+                         "({rate_hz})", first)
+    items = entries(consumer, got, inflate, f)
+    scalars: list[tuple[str, str | float, str]] = [("rostopic", rostopic, ""), ("update_rate", f, f"Hz, {how}")]
+    scalars += [(e.key.name, e.value, f"{e.key.unit}; {e.statement}") for e in items]
+    srcs = ", ".join(figs.sources + (() if intrinsics is None else (Path(intrinsics[1]).name,)))
+    header = header_lines(consumer, srcs, inflate, f, how)
+    header[0] += " (ImuParameters keys; nest it under imu0: for an IMU chain)"
     if sensors:
         header += ["convention: modelling, Kalibr's direction (scale-misalignment model): a_meas = M_accel a_i + b_a, "
                    "w_meas = M_gyro C_gyro_i w_i + A_gyro C_gyro_i a_i + b_g; M lower triangular = imu-align's M "
@@ -311,43 +291,63 @@ def _kalibr(results: list[tuple[Result, str]], rostopic: str) -> str:
                    "from its input imu.yaml (its calibration starts from M = I, C = I, A = 0); it uses the noise keys"]
     else:
         header.append(f"convention: noise only (no intrinsics); frame: {frame}")
-    if missing:
-        header.append("missing (Kalibr needs them): " + ", ".join(missing) + "; export an Allan result of each "
-                      "sensor together with this one")
-    return kalibr_yaml("\n".join(header), scalars, sensors)
+    return Exported(kalibr_yaml("\n".join(header), scalars, sensors), noise_summary(items, f, inflate, []))
 
 
 # ---------------------------------------------------------------- dispatch
 
-def export_text(results: list[tuple[Result, str]], to: str, name: str | None = None, rostopic: str = "/imu0") -> str:
+def export(results: list[tuple[Result, str]], to: str, name: str | None = None, rostopic: str = "/imu0",
+           inflate: float = 1.0, rate_hz: float | None = None, part: Part | None = None,
+           floor_tau: float | None = None) -> Exported:
     """The export ``to`` of the results (each with its file name, for messages and the file's statement).
 
     Parameters
     ----------
     results : list of (Result, str)
         One result for ``c``, ``csv`` and ``imucal``; for ``kalibr`` at most one Allan result per sensor and one
-        alignment or calibration.
-    to : {"kalibr", "c", "csv", "imucal"}
+        alignment or calibration; for the other noise consumers (:data:`NOISE`) at most one Allan result per sensor.
+    to : {"kalibr", "openvins", "vins", "px4", "ardupilot", "c", "csv", "imucal"}
     name : str, optional
         C identifier prefix of a header's arrays (default ``IMU_ALIGN``, ``IMU_CAL``, ``IMU_MAG``).
     rostopic : str
-        Kalibr's ``rostopic``.
+        Kalibr's and OpenVINS's ``rostopic``.
+    inflate : float
+        Noise consumers: every noise value multiplied by it, >= 1 (1: as measured).
+    rate_hz : float, optional
+        Noise consumers: the rate of the conversion: the IMU's (Kalibr, OpenVINS, VINS-Fusion; default the Allan
+        record's) or the filter's prediction rate (PX4, ArduPilot; default their documented one).
+    part : Part, optional
+        A datasheet giving the gyroscope's figures (noise consumers).
+    floor_tau : float, optional
+        s: the averaging time of the datasheet's Allan floor, bounding ``K`` from ``B``.
 
     Returns
     -------
-    str
-        The file's text.
+    Exported
+        The file's text, and the lines the terminal shows (noise consumers: each key, value and conversion).
 
     Raises
     ------
     InputError
         A result that has no such export (naming its file and the results that have), several results where
-        one is taken, a matrix Kalibr cannot take (``det <= 0``, counts), a non-finite value in a C header.
+        one is taken, a matrix Kalibr cannot take (``det <= 0``, counts), a value a C float cannot hold, an ``A``
+        that is not ``M^-1``, a noise term neither identified nor bounded, a noise consumer's figures missing.
     """
     if to not in EXPORTS:
-        raise InputError(f"unknown export '{to}'; choose {', '.join(EXPORTS)}", "{to}")
+        raise InputError(f"unknown export '{literal(to)}'; choose {', '.join(EXPORTS)}", "{to}")
+    for r, where in results:
+        if isinstance(r, AlignmentResult):
+            check_inverse(r.M, r.A, where, "")
     if to == "kalibr":
-        return _kalibr(results, rostopic)
+        return _kalibr(results, rostopic, inflate, rate_hz, part, floor_tau)
+    if to in NOISE:
+        allan: list[tuple[AllanJob, str]] = []
+        for r, where in results:
+            if not isinstance(r, AllanJob):
+                raise InputError(f"holds an {r.FORMAT} result, which has no noise figures: {_SHORT[to]} come from "
+                                 "allan results (one per sensor); give those", where)
+            allan.append((r, where))
+        return noise_export(gather(allan, part, floor_tau), to, results[0][1], rostopic, inflate, rate_hz)
     if len(results) != 1:
         raise InputError(f"a {_SHORT[to]} comes from one result, not {len(results)}; give one (several only with "
                          "{to=kalibr})", results[-1][1])
@@ -356,13 +356,14 @@ def export_text(results: list[tuple[Result, str]], to: str, name: str | None = N
         raise _refuse(r, to, where)
     if to == "c":
         if isinstance(r, AlignmentResult):  # the very header 'matrix' writes
-            return r.as_c_header(f"imu-align alignment {_source(r, where)}", name or "IMU_ALIGN")
+            c_values(r.A, to_unit(r.bias, r.units), where)
+            return Exported(r.as_c_header(f"imu-align alignment {_source(r, where)}", name or "IMU_ALIGN"))
         if isinstance(r, CalibrationSet):
-            return _calibration_header(r, name or "IMU_CAL", where)
+            return Exported(_calibration_header(r, name or "IMU_CAL", where))
         assert isinstance(r, MagCalibration), r.FORMAT  # EXPORTS["c"]
-        return _mag_header(r, name or "IMU_MAG", where)
+        return Exported(_mag_header(r, name or "IMU_MAG", where))
     if to == "csv":
-        return _allan_csv(r, where) if isinstance(r, AllanJob) else _matrix_csv(r, where)
+        return Exported(_allan_csv(r, where) if isinstance(r, AllanJob) else _matrix_csv(r, where))
     assert isinstance(r, CalibrationSet), r.FORMAT  # EXPORTS["imucal"]
     missing = [s for s in ("accelerometer", "gyroscope") if s not in r.sensors]
     if missing:
@@ -371,4 +372,11 @@ def export_text(results: list[tuple[Result, str]], to: str, name: str | None = N
     _physical(r, "imucal's K R", where)
     for s, c in r.sensors.items():
         _inverse(c.M, f"{where}: {s}.M")  # imucal's K R = M: a singular M has no R
-    return json.dumps(r.as_imucal(), indent=2) + "\n"
+    return Exported(json.dumps(r.as_imucal(), indent=2) + "\n")
+
+
+def export_text(results: list[tuple[Result, str]], to: str, name: str | None = None, rostopic: str = "/imu0",
+                **noise) -> str:
+    """The text of :func:`export` (the noise consumers' options as keywords: ``inflate``, ``rate_hz``, ``part``,
+    ``floor_tau``)."""
+    return export(results, to, name, rostopic, **noise).text

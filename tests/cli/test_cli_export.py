@@ -126,7 +126,8 @@ def test_kalibr_noise_reads_back_to_the_allan_numbers_and_the_truth(results, tmp
 
 
 def test_kalibr_intrinsics_of_an_alignment_in_kalibrs_direction(results):
-    y = yaml.safe_load(_export(results / "align.json", "--to", "kalibr"))
+    y = yaml.safe_load(_export(results / "align.json", results / "allan.json", results / "allan_acc.json", "--to",
+                               "kalibr"))
     m = np.array(json.loads((results / "align.json").read_text())["M"])
     low, c = np.array(y["gyroscopes"]["M"]), np.array(y["gyroscopes"]["C_gyro_i"])
     assert y["model"] == "scale-misalignment" and np.all(np.triu(low, 1) == 0)
@@ -135,12 +136,19 @@ def test_kalibr_intrinsics_of_an_alignment_in_kalibrs_direction(results):
     w = np.random.default_rng(0).normal(0, 1, (3, 50))
     assert np.allclose(low @ c @ w, m @ w, atol=1e-12)
     assert np.array_equal(np.array(y["gyroscopes"]["A"]), np.zeros((3, 3)))
-    assert "update_rate" not in y and "missing (Kalibr needs them): update_rate" in _export(results / "align.json", "--to",
-                                                                                           "kalibr")
+    assert y["update_rate"] == FS and y["gyroscope_noise_density"] > 0 and y["accelerometer_random_walk"] > 0
+
+
+def test_kalibr_of_an_alignment_alone_is_refused_it_has_no_noise_figures(results, tmp_path):
+    """Issue 28: an imu.yaml without the noise keys Kalibr reads is not written (Kalibr's ImuParameters raises on a
+    missing key): one line, exit 2, saying what to give."""
+    _refused(tmp_path, results / "align.json", "--to", "kalibr",
+             words=["align.json", "no noise figures", "gyroscope_noise_density", "allan"])
+    _refused(tmp_path, results / "cal.json", "--to", "kalibr", words=["cal.json", "no noise figures"])
 
 
 @pytest.mark.parametrize("seed", range(4))
-def test_kalibr_intrinsics_of_a_calibration_reproduce_its_model(tmp_path, seed):
+def test_kalibr_intrinsics_of_a_calibration_reproduce_its_model(results, tmp_path, seed):
     """raw_a = M_a a + b_a and raw_g = M_g w + K_ga a + b_g (imu-align) equal Kalibr's a_meas = M_accel a_i and
     w_meas = M_gyro C_gyro_i w_i + A C_gyro_i a_i, in the frame i = R (calibration frame) the file defines."""
     rng = np.random.default_rng(seed)
@@ -154,7 +162,7 @@ def test_kalibr_intrinsics_of_a_calibration_reproduce_its_model(tmp_path, seed):
     path = tmp_path / "cal.json"
     save_result(path, cs)
     d = json.loads(path.read_text())
-    y = yaml.safe_load(_export(path, "--to", "kalibr"))
+    y = yaml.safe_load(_export(path, results / "allan.json", results / "allan_acc.json", "--to", "kalibr"))
     ma, mg = np.array(d["accelerometer"]["M"]), np.array(d["gyroscope"]["M"])
     kga = np.array(d["gyroscope"]["g_sensitivity"]) * DEG          # deg/s per m/s^2 -> (rad/s) per (m/s^2)
     la, lg = np.array(y["accelerometers"]["M"]), np.array(y["gyroscopes"]["M"])

@@ -143,7 +143,24 @@ def test_csv_scale_rows_carry_ms_unit(run_cli, tmp_path):
 
 # ---------------------------------------------------------------- bug 11: the Kalibr random walk
 
-def test_kalibr_says_which_numbers_are_upper_bounds_and_that_it_ignores_the_intrinsics(run_cli, tmp_path):
+@pytest.fixture(scope="module")
+def rest(tmp_path_factory):
+    """Allan results of 3-minute white-noise records at rest: a gyroscope (g.json) and an accelerometer reading
+    gravity (acc.json); neither identifies a bias random walk."""
+    from align.cli import run
+
+    d, fs = tmp_path_factory.mktemp("rest"), 100.0
+    gyro = simulate_noise(int(fs * 180), fs, NoiseSpec(white=0.3 * DEG / 60), channels=3, seed=5) / DEG
+    acc = simulate_noise(int(fs * 180), fs, NoiseSpec(white=6e-4), channels=3, seed=6) + np.array([0.2, -0.1, 9.8])
+    np.save(d / "g.npy", gyro)
+    np.save(d / "acc.npy", acc)
+    assert run(["allan", str(d / "g.npy"), "--rate-hz", str(fs), "--json", str(d / "g.json")]) == 0
+    assert run(["allan", str(d / "acc.npy"), "--rate-hz", str(fs), "--units", "m/s^2", "--columns",
+                "acc_x,acc_y,acc_z", "--json", str(d / "acc.json")]) == 0
+    return d
+
+
+def test_kalibr_says_which_numbers_are_upper_bounds_and_that_it_ignores_the_intrinsics(run_cli, rest, tmp_path):
     """A 3-minute white-noise record cannot identify a bias random walk: the Allan JSON gives its 95 % upper bound
     (terms.*.upper_bound), and imu.yaml writes that same number with a comment saying it is an upper bound.
 
@@ -152,14 +169,9 @@ def test_kalibr_says_which_numbers_are_upper_bounds_and_that_it_ignores_the_intr
     identity quaternion, M_accel_Dv and M_gyro_Dv at np.eye(3) and M_accel_gyro_Dv at np.zeros((3,3)); the
     imu.yaml's accelerometers/gyroscopes are only printed (printDetails) and written back (setIntrisicsMatrices).
     """
-    fs = 100.0
-    gyro = simulate_noise(int(fs * 180), fs, NoiseSpec(white=0.3 * DEG / 60), channels=3, seed=5) / DEG
-    np.save(tmp_path / "g.npy", gyro)
-    res = run_cli("allan", tmp_path / "g.npy", "--rate-hz", fs, "--json", tmp_path / "g.json")
+    res = run_cli("export", rest / "g.json", rest / "acc.json", "--to", "kalibr")
     assert res.code == 0, res.err
-    res = run_cli("export", tmp_path / "g.json", "--to", "kalibr")
-    assert res.code == 0, res.err
-    d = json.loads((tmp_path / "g.json").read_text())
+    d = json.loads((rest / "g.json").read_text())
     terms = {ch: f["terms"]["rate_random_walk"] for ch, f in d["fit"].items()}
     assert not any(t["identifiable"] for t in terms.values())
     assert {t["unit"] for t in terms.values()} == {"deg/h/sqrt(h)"}
@@ -171,7 +183,7 @@ def test_kalibr_says_which_numbers_are_upper_bounds_and_that_it_ignores_the_intr
     noise = next(ln for ln in res.out.splitlines() if ln.startswith("gyroscope_noise_density:"))
     assert "fitted" in noise and "UPPER BOUND" not in noise
     res = run_cli("matrix", SESSION, "--plan", PLAN, "--json", tmp_path / "a.json")
-    text = run_cli("export", tmp_path / "a.json", tmp_path / "g.json", "--to", "kalibr").out
+    text = run_cli("export", tmp_path / "a.json", rest / "g.json", rest / "acc.json", "--to", "kalibr").out
     assert re.search(r"Kalibr does not read accelerometers/gyroscopes from its input imu.yaml .*M = I, C = I, A = 0",
                      text)
 
@@ -186,13 +198,14 @@ def test_a_file_that_is_not_a_result_gets_one_line_saying_what_to_give(run_cli, 
     _one_line(run_cli("export", tmp_path / "none.json", "--to", "c"), "file not found")
 
 
-def test_name_and_rostopic_are_refused_where_they_mean_nothing(run_cli, tmp_path):
+def test_name_and_rostopic_are_refused_where_they_mean_nothing(run_cli, rest, tmp_path):
     res = run_cli("matrix", SESSION, "--plan", PLAN, "--json", tmp_path / "a.json")
     assert res.code == 0, res.err
     _one_line(run_cli("export", tmp_path / "a.json", "--to", "csv", "--name", "X"), "--name", "--to c")
     _one_line(run_cli("export", tmp_path / "a.json", "--to", "c", "--rostopic", "/imu"), "--rostopic", "--to kalibr")
     assert run_cli("export", tmp_path / "a.json", "--to", "c", "--name", "X").code == 0
-    assert "rostopic: \"/imu\"" in run_cli("export", tmp_path / "a.json", "--to", "kalibr", "--rostopic", "/imu").out
+    assert "rostopic: \"/imu\"" in run_cli("export", tmp_path / "a.json", rest / "g.json", rest / "acc.json", "--to",
+                                           "kalibr", "--rostopic", "/imu").out
 
 
 # ---------------------------------------------------------------- imucal's own calibrate()

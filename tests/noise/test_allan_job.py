@@ -218,5 +218,9 @@ def test_an_unidentified_random_walk_is_stated_as_its_upper_bound_in_json_and_ka
         si = parse_quantity(f"{rw['upper_bound']} {rw['unit']}", "rate_random_walk")
         assert c["gyroscope_random_walk"] == pytest.approx(si, rel=1e-9)
         bounds.append(c["gyroscope_random_walk"])
-    assert run(["export", str(out), "--to", "kalibr", "--out", str(yml)]) == 0
+    acc = simulate_noise(int(0.03 * 3600 * fs), fs, NoiseSpec(white=6e-4), 3, seed=5) + np.array([0.1, 0.2, 9.8])
+    np.save(tmp_path / "acc.npy", acc)
+    assert run(["allan", str(tmp_path / "acc.npy"), "--rate-hz", "100", "--units", "m/s^2", "--columns",
+                "acc_x,acc_y,acc_z", "--json", str(tmp_path / "acc.json")]) == 0
+    assert run(["export", str(out), str(tmp_path / "acc.json"), "--to", "kalibr", "--out", str(yml)]) == 0
     assert yaml.safe_load(yml.read_text())["gyroscope_random_walk"] == pytest.approx(max(bounds), rel=1e-6)
