@@ -8,9 +8,12 @@ A long log is hashed while the job computes: :func:`start_hashing` (called by :m
 the inputs are read) starts the SHA-256 in a background thread (``hashlib`` releases the GIL), and
 :meth:`Provenance.of` takes it, or hashes the file then when it changed since or was never started.
 
+A log may be a folder (a ROS 2 bag, an EuRoC dataset: :func:`align.io.files.existing_log`); its record is
+the SHA-256 of its files in sorted order (:func:`folder_digest`) and their total size.
+
 Public names
 ------------
-InputFile, Provenance, file_record, start_hashing, prehashed_record, plain
+InputFile, Provenance, file_record, folder_digest, start_hashing, prehashed_record, plain
 """
 
 from __future__ import annotations
@@ -28,7 +31,7 @@ from typing import Any
 
 from align import __version__
 
-__all__ = ["InputFile", "Provenance", "file_record", "start_hashing", "prehashed_record", "plain"]
+__all__ = ["InputFile", "Provenance", "file_record", "folder_digest", "start_hashing", "prehashed_record", "plain"]
 
 _CHUNK = 1 << 20
 
@@ -44,9 +47,9 @@ class InputFile:
     path : str
         The path as given.
     size : int
-        Bytes.
+        Bytes (of a folder: of its files).
     sha256 : str
-        Hex digest of the bytes.
+        Hex digest of the bytes (of a folder: :func:`folder_digest`).
     """
 
     role: str
@@ -58,21 +61,57 @@ class InputFile:
         return {"role": self.role, "path": self.path, "size": self.size, "sha256": self.sha256}
 
 
+def _sha256(p: Path) -> bytes:
+    """SHA-256 of a file's bytes (read in 1 MiB chunks: bounded memory for a long log)."""
+    digest = hashlib.sha256()
+    with open(p, "rb") as fh:
+        while block := fh.read(_CHUNK):
+            digest.update(block)
+    return digest.digest()
+
+
+def _folder_files(folder: Path) -> list[tuple[str, Path]]:
+    """The files under ``folder`` (in its sub-folders too) by their relative POSIX name, sorted."""
+    return sorted((p.relative_to(folder).as_posix(), p) for p in folder.rglob("*") if p.is_file())
+
+
+def folder_digest(folder: str | Path) -> tuple[int, str]:
+    """The total size and the SHA-256 of a folder's files: hex digest of, for each file in the sorted order of its
+    relative name (POSIX, UTF-8), the name, a NUL byte and the SHA-256 (32 bytes) of the file's bytes. A file
+    renamed, added, removed or changed changes it; the folder's own name and the files' times do not.
+
+    Examples
+    --------
+    >>> import tempfile, hashlib
+    >>> d = Path(tempfile.mkdtemp())
+    >>> _ = (d / "a.txt").write_bytes(b"abc")
+    >>> size, hexed = folder_digest(d)
+    >>> size, hexed == hashlib.sha256(b"a.txt\\0" + hashlib.sha256(b"abc").digest()).hexdigest()
+    (3, True)
+    """
+    outer, size = hashlib.sha256(), 0
+    for name, p in _folder_files(Path(folder)):
+        outer.update(name.encode() + b"\0" + _sha256(p))
+        size += p.stat().st_size
+    return size, outer.hexdigest()
+
+
 def file_record(role: str, path: str | Path) -> InputFile:
-    """Size and SHA-256 of a file (read in 1 MiB chunks: bounded memory for a long log).
+    """Size and SHA-256 of a file (read in 1 MiB chunks: bounded memory for a long log), or of a log folder
+    (:func:`folder_digest`).
 
     A file that cannot be read (removed since the job read it) has size -1 and an empty digest.
     """
     p = Path(path)
-    digest = hashlib.sha256()
     try:
-        with open(p, "rb") as fh:
-            while block := fh.read(_CHUNK):
-                digest.update(block)
+        if p.is_dir():
+            size, hexed = folder_digest(p)
+            return InputFile(role, str(path), size, hexed)
+        digest = _sha256(p).hex()
         size = p.stat().st_size
     except OSError:
         return InputFile(role, str(path), -1, "")
-    return InputFile(role, str(path), size, digest.hexdigest())
+    return InputFile(role, str(path), size, digest)
 
 
 _LOCK = threading.Lock()
@@ -81,11 +120,17 @@ _PENDING: dict[tuple[str, int, int], Future] = {}
 
 
 def _key(path: str | Path) -> tuple[str, int, int] | None:
+    """What tells whether a file changed since it was hashed: its size and time (of a folder: its files' total
+    size and latest time)."""
+    p = Path(path)
     try:
-        st = Path(path).stat()
+        if p.is_dir():
+            stats = [f.stat() for _, f in _folder_files(p)]
+            return str(p.resolve()), sum(s.st_size for s in stats), max((s.st_mtime_ns for s in stats), default=0)
+        st = p.stat()
     except OSError:
         return None
-    return str(Path(path).resolve()), st.st_size, st.st_mtime_ns
+    return str(p.resolve()), st.st_size, st.st_mtime_ns
 
 
 def start_hashing(paths: list[str | Path]) -> None:

@@ -17,7 +17,8 @@ from support import ROOT
 #: modules whose docstring examples are the API reference's (docs/*.rst automodule them, or the package they are in)
 MODULES = [
     "align.vocab",
-    "align.io.source", "align.io.noise_consumers", "align.io.dataflash", "align.io.dataflash_format", "align.noise.periodic",
+    "align.io.source", "align.io.inspect", "align.io.noise_consumers", "align.io.dataflash", "align.io.dataflash_format",
+    "align.noise.periodic",
     "align.job",
     "align.provenance",
     "align.results",

@@ -32,6 +32,7 @@ story      report, demo
 exports    export
 batch      batch, lot
 calibrate  calibrate ferraris | accel | mag | gyro
+inspect    inspect (what a log holds, before any job)
 """
 
 from __future__ import annotations
@@ -45,7 +46,19 @@ from typing import Annotated, Protocol, cast
 import typer
 
 from align import __version__
-from align.cli import alignment, batch, calibrate, exports, mechanics, navigation, noise, parts, simulate, story
+from align.cli import (
+    alignment,
+    batch,
+    calibrate,
+    exports,
+    inspect,
+    mechanics,
+    navigation,
+    noise,
+    parts,
+    simulate,
+    story,
+)
 from align.cli.options import rewrite_aliases, speller
 
 PROG = "imu-align"
@@ -74,7 +87,7 @@ def _root(
     pass
 
 
-_MODULES = (alignment, mechanics, parts, noise, navigation, story, exports, batch)
+_MODULES = (alignment, mechanics, parts, noise, navigation, story, exports, batch, inspect)
 for _module in _MODULES:
     for _name, _command in _module.COMMANDS.items():
         app.command(_name)(_command)

@@ -43,12 +43,13 @@ NoiseRatio = opt.Number("--noise-ratio", "Plan for noise this many times below t
 Accuracy = "Alignment goal, e.g. '0.1 deg'"
 
 
-def allan_options(logs: Any = (), columns: str | None = None, rate_hz: float | None = None, gyro_units: str = "deg/s",
-                  units: str | None = None, grid: str | list[float] = "dense", per_decade: int = 10,
-                  modified: bool = False, rate: float | str | None = None, accuracy: float | str | None = None,
-                  noise_ratio: float = 10.0, memory_limit_mb: float = 2000.0, skip_rows: int = 0,
-                  comment: str | None = None, delimiter: str | None = None, time_units: str | None = None,
-                  time_column: str | None = None, **_: Any):
+def allan_options(logs: Any = (), columns: str | None = None, rate_hz: float | None = None,
+                  gyro_units: str | None = None, units: str | None = None, grid: str | list[float] = "dense",
+                  per_decade: int = 10, modified: bool = False, rate: float | str | None = None,
+                  accuracy: float | str | None = None, noise_ratio: float = 10.0, memory_limit_mb: float = 2000.0,
+                  skip_rows: int = 0, comment: str | None = None, delimiter: str | None = None,
+                  time_units: str | None = None, time_column: str | None = None, topic: str | None = None,
+                  stamps: str | None = None, **_: Any):
     """The ``allan`` job's options from the command's parameters (Python names, as typer delivers them).
 
     The command, the batch and the report's noise step (``report --allan REC`` with its ``--columns``,
@@ -71,7 +72,8 @@ def allan_options(logs: Any = (), columns: str | None = None, rate_hz: float | N
     return AllanOptions(
         logs=tuple(Path(p) for p in paths), columns=tuple(opt.names(columns)) if columns is not None else None,
         time_column=time_column or None, rate_hz=rate_hz, gyro_units=gyro_units, units=units,
-        format=opt.log_format(skip_rows, comment, delimiter, time_units),
+        format=opt.log_format(skip_rows=skip_rows, comment=comment, delimiter=delimiter, time_units=time_units,
+                              topic=topic, stamps=stamps),
         grid=grid if isinstance(grid, str) else tuple(grid), per_decade=per_decade, modified=modified,
         rate=rate, accuracy=accuracy, noise_ratio=noise_ratio, memory_limit=float(memory_limit_mb) * 1e6)
 
@@ -89,13 +91,14 @@ def allan_files(result, inputs, params: dict) -> list[tuple[Path, bytes | str]]:
 
 def allan(
     logs: Annotated[list[Path], typer.Argument(metavar="LOG...", show_default=False, help=(
-        "Static recordings: .csv, .csv.gz, .npy or raw float64 .bin; several runs are pooled (each run's curve "
-        "and fit, a pooled curve fitted and planned from) and give the bias repeatability."))],
+        "Static recordings: .csv, .csv.gz, .npy, raw float64 .bin, or a log of several streams (a ROS bag, a ULog, a "
+        "DataFlash .bin: --topic); several runs are pooled (each run's curve and fit, a pooled curve fitted and "
+        "planned from) and give the bias repeatability."))],
     columns: opt.Columns("Data columns (default gyro_x,gyro_y,gyro_z); four names: the time column first. A text "
                          "log's time column is 'time' (--time-column) unless --rate-hz.", optional=True) = None,
     rate_hz: opt.RateHz("Sample rate, for files without a time column (.npy always); a time column, when the "
                         "file has one, must agree.") = None,
-    gyro_units: opt.GyroUnits("Unit of the data columns (an angular rate).") = "deg/s",
+    gyro_units: opt.GyroUnits("Unit of the data columns (an angular rate).", stated=True) = None,
     units: opt.Units("Any rate or acceleration unit instead of --gyro-units (e.g. g).") = None,
     grid: Annotated[str, typer.Option("--grid", parser=grid_value, metavar="GRID",
                                       help="dense | octave | decade | explicit taus '0.01,0.1,1' (s).")] = "dense",
@@ -115,6 +118,8 @@ def allan(
     delimiter: opt.Delimiter = None,
     time_units: opt.TimeUnits = None,
     time_column: opt.TimeColumn = None,
+    topic: opt.Topic = None,
+    stamps: opt.Stamps = None,
 ) -> None:
     """Allan deviation, noise-model fit and noise figures of static recordings."""
     params = dict(locals())
@@ -132,6 +137,8 @@ def allan(
     extra = allan_files(result, inputs, params)  # all or none: the plot is drawn before anything is written
     write_run(json_out, result, extra)  # all or none
     typer.echo(allan_summary(result))
+    for note in result.notes:  # the readers' remarks (a truncated last record)
+        typer.echo(f"note: {note}")
     if result.plan is not None:
         typer.echo("\n" + plan_summary(result.plan))
 

@@ -23,15 +23,17 @@ SENSOR_COLUMNS = {s.value: ",".join(("time", *s.columns)) for s in Sensor}
 SENSOR_DIMENSIONS = {s.value: s.dimension for s in Sensor}
 
 
-def apply_options(*, log: Path, alignment: Path, sensor: Any = None, gyro_units: str = "deg/s",
+def apply_options(*, log: Path, alignment: Path, sensor: Any = None, gyro_units: str | None = None,
                   units: str | None = None, columns: str | None = None, time_column: str | None = None,
                   rate_hz: float | None = None, skip_rows: int = 0, comment: str | None = None,
-                  delimiter: str | None = None, time_units: str | None = None, **_: Any):
+                  delimiter: str | None = None, time_units: str | None = None, topic: str | None = None,
+                  stamps: str | None = None, **_: Any):
     """The :class:`align.alignment.jobs.ApplyOptions` of ``imu-align apply``'s parameters (output options and unknown
     keys ignored)."""
     from align.alignment.jobs import ApplyOptions
 
-    source = opt.log_source(log, columns, rate_hz, units, time_column, skip_rows, comment, delimiter, time_units)
+    source = opt.log_source(log, columns, rate_hz=rate_hz, units=units, time_column=time_column, skip_rows=skip_rows,
+                            comment=comment, delimiter=delimiter, time_units=time_units, topic=topic, stamps=stamps)
     return ApplyOptions(log=source, alignment=alignment, sensor=None if sensor is None else value(sensor),
                         gyro_units=gyro_units)
 
@@ -69,8 +71,9 @@ def apply(
     out: opt.Input("--out", "Corrected CSV (same columns and units).", "OUT.csv"),
     sensor: opt.Choice("--sensor", ("accelerometer", "gyroscope", "magnetometer"),
                        "The sensor to correct, for a file holding several.") = None,
-    gyro_units: opt.GyroUnits() = "deg/s",
-    units: opt.Units("Unit of the columns for an accelerometer or magnetometer result (default: the result's).") = None,
+    gyro_units: opt.GyroUnits(stated=True) = None,
+    units: opt.Units("Unit of the columns for an accelerometer or magnetometer result (default: the unit the file "
+                     "states, else the result's).") = None,
     columns: opt.Columns("Data columns: x,y,z (with --time-column, default time), or time,x,y,z (time first); "
                          "default per sensor (gyro_x,..., acc_x,..., mag_x,...).", optional=True) = None,
     time_column: opt.TimeColumn = None,
@@ -80,6 +83,8 @@ def apply(
     comment: opt.Comment = None,
     delimiter: opt.Delimiter = None,
     time_units: opt.TimeUnits = None,
+    topic: opt.Topic = None,
+    stamps: opt.Stamps = None,
 ) -> None:
     """Correct a log: gyro w = A (g - b); accelerometer M^-1 (a - b); magnetometer soft_iron (m - hard_iron)."""
     params = dict(locals())

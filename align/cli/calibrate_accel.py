@@ -25,11 +25,11 @@ GRAVITY = "Local gravity"
 
 
 def accel_options(*, log: Path, positions: Path | None = None, columns: str | None = None,
-                  time_column: str | None = None, rate_hz: float | None = None, accel_units: str = "m/s^2",
+                  time_column: str | None = None, rate_hz: float | None = None, accel_units: str | None = None,
                   gravity: str | float | None = None, window: float = 1.0, factor: float = 6.0,
                   init_static: float | None = None, min_static: float = 1.0, skip_rows: int = 0,
                   comment: str | None = None, delimiter: str | None = None, time_units: str | None = None,
-                  **_: Any) -> AccelOptions:
+                  topic: str | None = None, stamps: str | None = None, **_: Any) -> AccelOptions:
     """The job's options from the command's parameters (Python names; output options and unknown keys ignored).
 
     Returns
@@ -41,8 +41,9 @@ def accel_options(*, log: Path, positions: Path | None = None, columns: str | No
 
     g = gravity if gravity is None or isinstance(gravity, float) else parse_quantity(gravity, "acceleration",
                                                                                       "{gravity}")
-    return AccelOptions(log=opt.log_source(log, columns, rate_hz, accel_units, time_column, skip_rows, comment,
-                                           delimiter, time_units),
+    return AccelOptions(log=opt.log_source(log, columns, rate_hz=rate_hz, units=accel_units, time_column=time_column,
+                                           skip_rows=skip_rows, comment=comment, delimiter=delimiter,
+                                           time_units=time_units, topic=topic, stamps=stamps),
                         positions=positions, gravity=g, window_s=window, factor=factor, init_static_s=init_static,
                         min_static_s=min_static)
 
@@ -69,8 +70,8 @@ def accel(
                          "those); four names time,x,y,z name the time column first.", optional=True) = None,
     time_column: opt.TimeColumn = None,
     rate_hz: opt.RateHz() = None,
-    accel_units: opt.UnitFlag("--accel-units", "Unit of the readings (an acceleration), 'counts', or the "
-                                                "size of one count: '16384 LSB/g'.") = "m/s^2",
+    accel_units: opt.UnitFlag("--accel-units", "Unit of the readings (an acceleration), 'counts', or the size of one "
+                              "count: '16384 LSB/g'." + opt.stated_default("m/s^2")) = None,
     gravity: opt.Text("--gravity", "acceleration", GRAVITY + " (default 9.80665 m/s^2, or the positions file's gravity).",
                       "ACCEL", POSITIVE, "'9.81 m/s^2'") = None,
     window: opt.Quantity("--window", "time", "Variance window of the static detector.", "TIME", DURATION, "'1 s'") = "1 s",
@@ -85,6 +86,8 @@ def accel(
     comment: opt.Comment = None,
     delimiter: opt.Delimiter = None,
     time_units: opt.TimeUnits = None,
+    topic: opt.Topic = None,
+    stamps: opt.Stamps = None,
 ) -> None:
     """Accelerometer multi-position calibration (known orientations, or |a| = g over many attitudes)."""
     params = dict(locals())

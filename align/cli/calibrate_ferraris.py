@@ -27,9 +27,10 @@ GRAVITY = "Local gravity"
 
 def ferraris_options(*, log: Path, sections: Path, rate_hz: float, turn_angle: float = -2 * 3.141592653589793,
                      gravity: float = 9.80665, accel_columns: str | None = None, gyro_columns: str | None = None,
-                     accel_units: str = "m/s^2", gyro_units: str = "deg/s", bias: Any = "pairwise",
+                     accel_units: str | None = None, gyro_units: str | None = None, bias: Any = "pairwise",
                      g_sensitivity: bool = True, skip_rows: int = 0, comment: str | None = None,
-                     delimiter: str | None = None, **_: Any) -> FerrarisOptions:
+                     delimiter: str | None = None, topic: str | None = None, stamps: str | None = None,
+                     **_: Any) -> FerrarisOptions:
     """The job's options from the command's parameters (Python names; output options and unknown keys ignored).
 
     Returns
@@ -39,7 +40,7 @@ def ferraris_options(*, log: Path, sections: Path, rate_hz: float, turn_angle: f
     from align.calibration.jobs import FerrarisOptions
     from align.io.source import LogSource
 
-    fmt = opt.log_format(skip_rows, comment, delimiter)
+    fmt = opt.log_format(skip_rows=skip_rows, comment=comment, delimiter=delimiter, topic=topic, stamps=stamps)
     gyro = LogSource(path=Path(log), columns=None if gyro_columns is None else tuple(names(gyro_columns)),
                      rate_hz=rate_hz, units=gyro_units, format=fmt)
     accel = LogSource(path=Path(log), columns=None if accel_columns is None else tuple(names(accel_columns)),
@@ -59,7 +60,8 @@ def ferraris_files(result: CalibrationSet, inputs: Any, params: dict[str, Any]) 
 
 
 def ferraris(
-    log: opt.Arg("Session log (CSV) with accelerometer and gyro columns.", "LOG"),
+    log: opt.Arg("Session log (CSV, or a stream of a log of several: --topic) with accelerometer and gyro columns.",
+                 "LOG"),
     sections: opt.Input("--sections", "imucal section list JSON: x_p ... z_a, x_rot, y_rot, z_rot.", "SECTIONS.json"),
     rate_hz: opt.RateHz("Sample rate.", required=True),
     turn_angle: opt.Quantity("--turn-angle", "angle", "Signed angle of each turn about the axis pointing up.",
@@ -70,8 +72,9 @@ def ferraris(
                                "when the file has those).", "--accel-columns", optional=True) = None,
     gyro_columns: opt.Columns("Gyro columns x,y,z (default gyro_x,gyro_y,gyro_z, or gyr_x,... / gx,... when the file "
                               "has those).", "--gyro-columns", optional=True) = None,
-    accel_units: opt.UnitFlag("--accel-units", "Accelerometer unit, or the size of one count ('16384 LSB/g').") = "m/s^2",
-    gyro_units: opt.GyroUnits("Gyro unit.") = "deg/s",
+    accel_units: opt.UnitFlag("--accel-units", "Accelerometer unit, or the size of one count ('16384 LSB/g')."
+                              + opt.stated_default("m/s^2")) = None,
+    gyro_units: opt.GyroUnits("Gyro unit.", stated=True) = None,
     bias: opt.Choice("--bias", ("pairwise", "lsq"), "Accelerometer bias: pairwise (Ferraris, tilt-robust) or lsq.") = "pairwise",
     g_sensitivity: opt.Flag("--g-sensitivity/--no-g-sensitivity",
                             "Estimate the gyro's g-sensitivity from the static faces.") = True,
@@ -80,6 +83,8 @@ def ferraris(
     skip_rows: opt.SkipRows = 0,
     comment: opt.Comment = None,
     delimiter: opt.Delimiter = None,
+    topic: opt.Topic = None,
+    stamps: opt.Stamps = None,
 ) -> None:
     """A Ferraris session (six static faces and a turn about each axis), as imucal records it."""
     params = dict(locals())

@@ -50,13 +50,14 @@ def rotation_table(rows) -> str:
 
 def gyro_options(*, log: Path, gyro_columns: str | None = None, accel_columns: str | None = None,
                  accel_log: Path | None = None, time_column: str | None = None, rate_hz: float | None = None,
-                 accel_units: str = "m/s^2", gyro_units: str = "deg/s", gravity: float = 9.80665,
+                 accel_units: str | None = None, gyro_units: str | None = None, gravity: float = 9.80665,
                  window: float = 1.0, factor: float = 6.0, gyro_factor: float = 1000.0,
                  init_static: float | None = None, min_static: float = 1.0, intervals: str | None = None,
                  gyro_range: str | float | None = None, drop_rotations: str | None = None,
                  g_sensitivity: bool = False, frame: Path | None = None,
                  mounting: MountingOption | str | None = None, skip_rows: int = 0, comment: str | None = None,
-                 delimiter: str | None = None, time_units: str | None = None, **_: Any) -> GyroOptions:
+                 delimiter: str | None = None, time_units: str | None = None, topic: str | None = None,
+                 stamps: str | None = None, **_: Any) -> GyroOptions:
     """The job's options from the command's parameters (Python names; output options and unknown keys ignored).
 
     Returns
@@ -68,13 +69,14 @@ def gyro_options(*, log: Path, gyro_columns: str | None = None, accel_columns: s
     from align.io.logs import sensor_scale
     from align.units import parse_quantity
 
-    fmt = (skip_rows, comment, delimiter, time_units)
-    gyro = opt.log_source(log, gyro_columns, rate_hz, gyro_units, time_column, *fmt)
-    accel = opt.log_source(accel_log if accel_log is not None else log, accel_columns, rate_hz, accel_units,
-                           time_column if accel_log is not None else None, *fmt)
+    fmt = dict(skip_rows=skip_rows, comment=comment, delimiter=delimiter, time_units=time_units, topic=topic,
+               stamps=stamps)
+    gyro = opt.log_source(log, gyro_columns, rate_hz=rate_hz, units=gyro_units, time_column=time_column, **fmt)
+    accel = opt.log_source(accel_log if accel_log is not None else log, accel_columns, rate_hz=rate_hz,
+                           units=accel_units, time_column=time_column if accel_log is not None else None, **fmt)
     grange: float | None
     if isinstance(gyro_range, str):
-        shown = sensor_scale(gyro_units, "angular_rate", "gyro_units", counts=True)[1]
+        shown = sensor_scale(gyro_units or "deg/s", "angular_rate", "gyro_units", counts=True)[1]
         grange = parse_quantity(gyro_range, "counts" if shown == "counts" else "angular_rate", "{gyro_range}")
     else:
         grange = gyro_range
@@ -126,9 +128,9 @@ def gyro(
     time_column: opt.TimeColumn = None,
     rate_hz: opt.RateHz() = None,
     accel_units: opt.UnitFlag("--accel-units", "Accelerometer unit, 'counts' (M then in counts per m/s^2), or the "
-                                               "size of one count ('16384 LSB/g').") = "m/s^2",
+                              "size of one count ('16384 LSB/g')." + opt.stated_default("m/s^2")) = None,
     gyro_units: opt.GyroUnits("Gyro unit, e.g. deg/s, 'counts' (M then in counts per rad/s), or the size of one count "
-                              "('131 LSB/(deg/s)').") = "deg/s",
+                              "('131 LSB/(deg/s)').", stated=True) = None,
     gravity: opt.Quantity("--gravity", "acceleration", "Local gravity.", "ACCEL", POSITIVE, "'9.81 m/s^2'") =
         "9.80665 m/s^2",
     window: opt.Quantity("--window", "time", "Variance window of the static detector.", "TIME", DURATION, "'1 s'") = "1 s",
@@ -162,6 +164,8 @@ def gyro(
     comment: opt.Comment = None,
     delimiter: opt.Delimiter = None,
     time_units: opt.TimeUnits = None,
+    topic: opt.Topic = None,
+    stamps: opt.Stamps = None,
 ) -> None:
     """Gyro (and accelerometer) calibration from rotations between static poses: imu_tk's method, no rate table.
 

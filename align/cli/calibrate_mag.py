@@ -22,10 +22,11 @@ if TYPE_CHECKING:
     from align.calibration.magnetometer import MagCalibration
 
 
-def mag_options(*, log: Path, columns: str | None = None, mag_units: str = "uT", field: str | float | None = None,
-                model: Any = "symmetric", accel_columns: str | None = None, dip: float | None = None,
-                axis_down: str | None = None, skip_rows: int = 0, comment: str | None = None,
-                delimiter: str | None = None, **_: Any) -> MagOptions:
+def mag_options(*, log: Path, columns: str | None = None, mag_units: str | None = None,
+                field: str | float | None = None, model: Any = "symmetric", accel_columns: str | None = None,
+                dip: float | None = None, axis_down: str | None = None, skip_rows: int = 0, comment: str | None = None,
+                delimiter: str | None = None, topic: str | None = None, stamps: str | None = None,
+                **_: Any) -> MagOptions:
     """The job's options from the command's parameters (Python names; output options and unknown keys ignored).
 
     Returns
@@ -38,13 +39,14 @@ def mag_options(*, log: Path, columns: str | None = None, mag_units: str = "uT",
 
     f: float | None
     if isinstance(field, str):
-        shown = parse_scale(mag_units, "magnetic_field", "{mag_units}")[1]
+        shown = parse_scale(mag_units or "uT", "magnetic_field", "{mag_units}")[1]
         f = parse_quantity(field, "counts" if shown == "counts" else "magnetic_field", "{field}")
     else:
         f = field
     down = None if axis_down is None else {a: v if isinstance(v, tuple) else Path(v)
                                            for a, v in parse_axis_down(axis_down).items()}
-    return MagOptions(log=opt.log_source(log, columns, None, mag_units, None, skip_rows, comment, delimiter),
+    return MagOptions(log=opt.log_source(log, columns, units=mag_units, skip_rows=skip_rows, comment=comment,
+                                         delimiter=delimiter, topic=topic, stamps=stamps),
                       accel_columns=None if accel_columns is None else tuple(names(accel_columns)), field=f,
                       model=cast(Any, value(model)), dip=dip, axis_down=down)
 
@@ -60,11 +62,12 @@ def mag_files(result: MagCalibration, inputs: MagInputs, params: dict[str, Any])
 
 
 def mag(
-    log: opt.Arg("Magnetometer capture while tumbling the device (CSV or blank-separated text).", "LOG"),
+    log: opt.Arg("Magnetometer capture while tumbling the device (CSV, blank-separated text, or a stream of a log of "
+                 "several: --topic).", "LOG"),
     columns: opt.Columns("Magnetometer columns x,y,z (default mag_x,mag_y,mag_z, or mx,my,mz when the file has those; "
                          "col0,col1,... for a file without header).", optional=True) = None,
     mag_units: opt.UnitFlag("--mag-units", "Unit: uT, nT, gauss, mG, 'counts', or the size of one count, e.g. "
-                            "'0.92 mG'.") = "uT",
+                            "'0.92 mG'." + opt.stated_default("uT")) = None,
     field: Annotated[str | None, typer.Option("--field", metavar="FIELD", help=(
         "Known field strength to refine to, e.g. '48.5 uT'."))] = None,
     model: opt.Choice("--model", ("sphere", "diagonal", "symmetric"), "Soft-iron model.") = "symmetric",
@@ -83,6 +86,8 @@ def mag(
     skip_rows: opt.SkipRows = 0,
     comment: opt.Comment = None,
     delimiter: opt.Delimiter = None,
+    topic: opt.Topic = None,
+    stamps: opt.Stamps = None,
 ) -> None:
     """Magnetometer hard and soft iron (ellipsoid fit with coverage gates), and the misalignment from axis-down turns."""
     params = dict(locals())

@@ -25,32 +25,34 @@ MAX_RUNS = 1_000_000
 
 
 def _trajectory_source(trajectory: Path, gyro_columns: str | None, time_column: str | None, rate_hz: float | None,
-                       gyro_units: str, skip_rows: int, comment, delimiter, time_units):
+                       gyro_units: str | None, **fmt: Any):
     """The trajectory's gyro columns as a LogSource, by the one column convention: its time column (``time``,
     ``--time-column``, or the first of four names) is read, unless ``--rate-hz`` is given with three names and no
     ``--time-column`` (a log without time); a log with neither is refused naming both options."""
     given = None if gyro_columns is None else names(gyro_columns)
     at_rate = rate_hz is not None and given is not None and len(given) == 3 and time_column is None
-    return opt.log_source(trajectory, gyro_columns, rate_hz if at_rate else None, gyro_units, time_column,
-                          skip_rows, comment, delimiter, time_units)
+    return opt.log_source(trajectory, gyro_columns, rate_hz=rate_hz if at_rate else None, units=gyro_units,
+                          time_column=time_column, **fmt)
 
 
 def drift_options(*, duration: float | None = None, allan: list[Path] | None = None, alignment: Path | None = None,
                   budget: Path | None = None, mount_error: Any = "attitude", imu: str | None = None,
                   parts: Path | None = None, manoeuvre: Path | None = None, trajectory: Path | None = None,
                   gyro_columns: str | None = None, accel_columns: str | None = None, time_column: str | None = None,
-                  gyro_units: str = "deg/s", accel_units: str = "m/s^2", runs: int = 1000, rate_hz: float | None = None,
+                  gyro_units: str | None = None, accel_units: str | None = None, runs: int = 1000,
+                  rate_hz: float | None = None,
                   nav_rate: float | None = None, turn_rate: float | None = None, heading: float = 0.0,
                   latitude: float | None = None, earth_rate: bool = False, gyro_bias: float | None = None,
                   accel_bias: float | None = None, flicker_span: int = 8, seed: int = 0, skip_rows: int = 0,
                   comment: str | None = None, delimiter: str | None = None, time_units: str | None = None,
-                  **_: Any):
+                  topic: str | None = None, stamps: str | None = None, **_: Any):
     """The :class:`align.navigation.jobs.DriftOptions` of ``imu-align drift``'s parameters (output options
     ignored)."""
     from align.navigation.jobs import DriftOptions
 
     source = None if trajectory is None else _trajectory_source(
-        trajectory, gyro_columns, time_column, rate_hz, gyro_units, skip_rows, comment, delimiter, time_units)
+        trajectory, gyro_columns, time_column, rate_hz, gyro_units, skip_rows=skip_rows, comment=comment,
+        delimiter=delimiter, time_units=time_units, topic=topic, stamps=stamps)
     more: dict[str, Any] = {k: v for k, v in {"turn_rate": turn_rate, "latitude": latitude}.items() if v is not None}
     return DriftOptions(
         duration=duration, allan=tuple(allan or ()), alignment=alignment, budget=budget,
@@ -101,8 +103,9 @@ def drift(
     accel_columns: opt.Columns("Accelerometer columns of --trajectory: x,y,z (default acc_x,acc_y,acc_z).",
                                "--accel-columns", optional=True) = None,
     time_column: opt.TimeColumn = None,
-    gyro_units: opt.GyroUnits("Gyro unit of --trajectory, e.g. deg/s or rad/s.") = "deg/s",
-    accel_units: opt.UnitFlag("--accel-units", "Accelerometer unit of --trajectory, e.g. m/s^2 or g.") = "m/s^2",
+    gyro_units: opt.GyroUnits("Gyro unit of --trajectory, e.g. deg/s or rad/s.", stated=True) = None,
+    accel_units: opt.UnitFlag("--accel-units", "Accelerometer unit of --trajectory, e.g. m/s^2 or g."
+                              + opt.stated_default("m/s^2")) = None,
     runs: opt.Whole("--runs", "Monte Carlo runs (2 to 1,000,000).", 2, MAX_RUNS, "1000") = 1000,
     rate_hz: opt.RateHz("Sensor sample rate of the mission (default 100 Hz), or of a --trajectory without a time "
                         "column.") = None,
@@ -128,6 +131,8 @@ def drift(
     comment: opt.Comment = None,
     delimiter: opt.Delimiter = None,
     time_units: opt.TimeUnits = None,
+    topic: opt.Topic = None,
+    stamps: opt.Stamps = None,
 ) -> None:
     """Attitude, velocity and position error growth from the residual sensor errors over a mission."""
     params = dict(locals())

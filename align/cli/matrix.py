@@ -20,17 +20,19 @@ from align.vocab import Sensor
 #: the columns ``matrix`` reads by default, time first (the old spelling of ``--columns``, still accepted)
 GYRO_COLUMNS = ",".join(("time", *Sensor.GYROSCOPE.columns))
 
-Log = opt.Arg("Gyro log: .csv, .csv.gz, .npy or .parquet.", "LOG")
+Log = opt.Arg("Gyro log: .csv, .csv.gz, .npy, .parquet, or a log of several streams (a ROS bag, a ULog, a DataFlash "
+              "log: --topic; 'imu-align inspect LOG' lists them).", "LOG")
 
 
-def matrix_options(*, log: Path, plan: Path, method: Any = "auto", gyro_units: str = "deg/s",
+def matrix_options(*, log: Path, plan: Path, method: Any = "auto", gyro_units: str | None = None,
                    columns: str | None = None, time_column: str | None = None, rate_hz: float | None = None,
                    segments: Path | None = None, gyro_range: float | None = None, min_dwell: float | None = None,
                    window: float | None = None, margin: float | None = None, static_threshold: float | None = None,
                    rate_tolerance: float | None = None, scale_tolerance: float | None = None,
                    axis_to_axis: float | None = None, scale_spec: float | None = None, two_axis_variant: Any = None,
                    earth: bool | None = None, skip_rows: int = 0, comment: str | None = None,
-                   delimiter: str | None = None, time_units: str | None = None, **_: Any):
+                   delimiter: str | None = None, time_units: str | None = None, topic: str | None = None,
+                   stamps: str | None = None, **_: Any):
     """The :class:`align.alignment.jobs.MatrixOptions` of ``imu-align matrix``'s parameters (SI, as the options
     parse them; output options and unknown keys ignored; a parameter left None keeps the job's default)."""
     from align.alignment.jobs import MatrixOptions
@@ -41,7 +43,9 @@ def matrix_options(*, log: Path, plan: Path, method: Any = "auto", gyro_units: s
         "min_dwell": min_dwell, "window": window, "margin": margin, "static_threshold": static_threshold,
         "rate_tolerance": rate_tolerance, "scale_tolerance": scale_tolerance, "axis_to_axis": axis_to_axis,
         "scale_spec": scale_spec, "earth": earth}
-    source = opt.log_source(log, columns, rate_hz, gyro_units, time_column, skip_rows, comment, delimiter, time_units)
+    source = opt.log_source(log, columns, rate_hz=rate_hz, units=gyro_units, time_column=time_column,
+                            skip_rows=skip_rows, comment=comment, delimiter=delimiter, time_units=time_units, topic=topic,
+                            stamps=stamps)
     return MatrixOptions(log=source, plan=plan, **{k: v for k, v in given.items() if v is not None})
 
 
@@ -64,7 +68,7 @@ def matrix(
                     "(latitude, table_axis, rest).", "PLAN.toml"),
     method: opt.Choice("--method", ("auto", "rate", "angle", "lsq", "two-axis"),
                    "Estimator; auto: lsq for three turned axes, two-axis for two.") = "auto",
-    gyro_units: opt.GyroUnits() = "deg/s",
+    gyro_units: opt.GyroUnits(stated=True) = None,
     columns: opt.Columns("Gyro columns: x,y,z (with --time-column, default time), or time,x,y,z (time first); "
                          f"default {GYRO_COLUMNS}.", optional=True) = None,
     time_column: opt.TimeColumn = None,
@@ -102,6 +106,8 @@ def matrix(
     comment: opt.Comment = None,
     delimiter: opt.Delimiter = None,
     time_units: opt.TimeUnits = None,
+    topic: opt.Topic = None,
+    stamps: opt.Stamps = None,
 ) -> None:
     """Alignment matrix M and A = M^-1 from rate-table data."""
     params = dict(locals())

@@ -18,19 +18,24 @@ live in :mod:`align.cli.parsers`, re-exported here). Nothing here imports
 numpy or the library's heavy modules.
 
 A command that reads a log takes the logger file options :data:`SkipRows`,
-:data:`Comment`, :data:`Delimiter` (text logs) and :data:`TimeUnits` (a time
-column), and builds the library's ``LogFormat`` from them with :func:`log_format`.
+:data:`Comment`, :data:`Delimiter` (text logs), :data:`TimeUnits` (a time
+column), :data:`Topic` and :data:`Stamps` (a log of several streams: a ROS bag,
+a ULog, a DataFlash log), and builds the library's ``LogFormat`` from them with
+:func:`log_format` (and its ``LogSource`` with :func:`log_source`). A unit option
+left out means the unit the file states (a ULog, a bag), else the sensor's
+default (:func:`stated_default` says so in the help).
 
 Public names
 ------------
 FLAGS, COMMAND_FLAGS, ALIASES, spell, speller, rewrite_aliases (the spelling of fields and flags);
 Domain, ANY, POSITIVE, NONNEGATIVE, NONZERO, ACCURACY, DURATION, PAUSE, TOLERANCE, DIP, MAX_RATE_HZ
 (the domains of values);
-hertz, quantity, checked_text, number, whole, delimiter, comment, time_units, split_columns, names, value
-(values at the edge);
+hertz, quantity, checked_text, number, whole, delimiter, comment, time_units, topic, stamps, split_columns, names,
+value (values at the edge);
 JsonOut, Seed, MonteCarlo, RateHz, Quantity, OptQuantity, Text, Number, Whole, Choice, Columns, UnitFlag, GyroUnits,
-Units, Arg, Input, OptInput, Flag, SkipRows, Comment, Delimiter, TimeColumn, TimeUnits (typed options: ``name: Type = default``);
-log_format (the logger file options as the library's ``LogFormat``)
+Units, Arg, Input, OptInput, Flag, SkipRows, Comment, Delimiter, TimeColumn, TimeUnits, Topic, Stamps (typed options:
+``name: Type = default``); stated_default (the help of a unit option);
+log_format, log_source (the log options as the library's ``LogFormat`` and ``LogSource``)
 """
 
 from __future__ import annotations
@@ -62,7 +67,9 @@ from align.cli.parsers import (  # noqa: F401  (re-exported: the commands take t
     hertz,
     number,
     quantity,
+    stamps,
     time_units,
+    topic,
     whole,
 )
 
@@ -100,6 +107,8 @@ FLAGS: dict[str, str] = {
     "comment": "--comment",
     "delimiter": "--delimiter",
     "time_units": "--time-units",
+    "topic": "--topic",
+    "stamps": "--stamps",
     # positional arguments
     "log": "LOG",
     "logs": "LOG...",
@@ -277,15 +286,24 @@ def Columns(help: str, flag: str = "--columns", optional: bool = False):
     return Annotated[str | None if optional else str, typer.Option(flag, metavar="NAMES", help=help)]
 
 
-def UnitFlag(flag: str, help: str, optional: bool = False):
-    """A unit option (``--gyro-units``, ``--accel-units``, ``--mag-units``, ``--units``); the library checks it."""
+def stated_default(unit: str) -> str:
+    """The end of a unit option's help: what leaving it out means (``default: the unit the file states, else deg/s``)."""
+    return f" Default: the unit the file states (a ULog, a bag), else {unit}."
+
+
+def UnitFlag(flag: str, help: str, optional: bool = True):
+    """A unit option (``--gyro-units``, ``--accel-units``, ``--mag-units``, ``--units``); the library checks it.
+    None (left out): the unit the file states, else the sensor's default (say which with :func:`stated_default`)."""
     return Annotated[str | None if optional else str, typer.Option(flag, metavar="UNIT", help=help)]
 
 
 def GyroUnits(help: str = "Unit of the gyro columns, e.g. deg/s, rad/s, mdps, or the size of one count: "
-                          "'0.0076336 deg/s' or '131 LSB/(deg/s)'."):
-    """``--gyro-units``."""
-    return UnitFlag("--gyro-units", help)
+                          "'0.0076336 deg/s' or '131 LSB/(deg/s)'.", stated: bool = False):
+    """``--gyro-units``; ``stated``: the unit of a log read (None when left out: the unit the file states, else
+    deg/s; the help says so); else a unit the command writes (a default in the signature)."""
+    if not stated:
+        return UnitFlag("--gyro-units", help, optional=False)
+    return UnitFlag("--gyro-units", help + stated_default("deg/s"))
 
 
 def Units(help: str):
@@ -309,25 +327,38 @@ TimeColumn = Annotated[str | None, typer.Option("--time-column", metavar="NAME",
     "Name of the time column (default: time; not read with --rate-hz)."))]
 #: ``--time-units``: the unit of the time column, detected when left out
 TimeUnits = Annotated[str | None, typer.Option("--time-units", parser=time_units, metavar="UNIT", help=(
-    "Unit of the time column: s, ms, us or ns (default: detected from the sample interval)."))]
+    "Unit of the time column: s, ms, us or ns (default: the unit the file states, else detected from the sample "
+    "interval)."))]
+#: ``--topic NAME``: the stream of a log of several (a ROS bag's topic, a ULog's topic:instance, a DataFlash message)
+Topic = Annotated[str | None, typer.Option("--topic", parser=topic, metavar="TOPIC", help=(
+    "The stream to read from a log of several: a ROS topic (/imu0), a ULog topic and instance (sensor_gyro:1), a "
+    "DataFlash message and instance (IMU:1). Default: the log's IMU stream (with several, its reader's choice, "
+    "recorded in the result); 'imu-align inspect LOG' lists them."))]
+#: ``--stamps header|record``: which time a stream's samples carry
+Stamps = Annotated[str | None, typer.Option("--stamps", parser=stamps, metavar="header|record", help=(
+    "Time stamps of a stream that has two: header (the sensor's, default) or record (when the recorder wrote the "
+    "message)."))]
 
 
-def log_format(skip_rows: int = 0, comment: str | None = None, delimiter: str | None = None,
-               time_units: str | None = None):
+def log_format(*, skip_rows: int = 0, comment: str | None = None, delimiter: str | None = None,
+               time_units: str | None = None, topic: str | None = None, stamps: str | None = None):
     """The logger file options as the library's ``align.io.formats.LogFormat`` (a comment character equal to the
-    delimiter is refused there, naming ``{comment}``)."""
+    delimiter is refused there, naming ``{comment}``; a topic for a log of one stream when the log is read)."""
     from align.io.formats import LogFormat
 
-    return LogFormat(skip_rows, comment, delimiter, time_units)
+    return LogFormat(skip_rows=skip_rows, comment=comment, delimiter=delimiter, time_units=time_units, topic=topic,
+                     stamps=stamps)
 
 
-def log_source(path, columns, rate_hz: float | None = None, units: str | None = None, time_column: str | None = None,
-               skip_rows: int = 0, comment: str | None = None, delimiter: str | None = None,
-               time_units: str | None = None):
-    """The log options of a command as the library's ``align.io.source.LogSource`` (``columns`` as typed: a comma
-    list, or None for the sensor's defaults)."""
+def log_source(path, columns: str | None = None, *, rate_hz: float | None = None, units: str | None = None,
+               time_column: str | None = None, **format_fields):
+    """The log options of a command as the library's ``align.io.source.LogSource``.
+
+    ``columns`` as typed (a comma list, or None for the sensor's defaults); ``units`` None: the unit the file
+    states, else the sensor's default; ``format_fields``: the keyword arguments of :func:`log_format` (``skip_rows``,
+    ``comment``, ``delimiter``, ``time_units``, ``topic``, ``stamps``).
+    """
     from align.io.source import LogSource
 
     return LogSource(path=Path(path), columns=None if columns is None else tuple(names(columns)),
-                     time_column=time_column, rate_hz=rate_hz, units=units,
-                     format=log_format(skip_rows, comment, delimiter, time_units))
+                     time_column=time_column, rate_hz=rate_hz, units=units, format=log_format(**format_fields))

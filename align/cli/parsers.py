@@ -8,8 +8,8 @@ modules (the library's unit and format parsers are imported when a value is pars
 Public names
 ------------
 Domain, ANY, POSITIVE, NONNEGATIVE, NONZERO, ACCURACY, DURATION, PAUSE, TOLERANCE, DIP, MAX_RATE_HZ
-(the domains of values); hertz, quantity, checked_text, number, whole, delimiter, comment, time_units
-(values at the edge)
+(the domains of values); hertz, quantity, checked_text, number, whole, delimiter, comment, time_units, topic,
+stamps (values at the edge)
 """
 
 from __future__ import annotations
@@ -211,4 +211,21 @@ def time_units(text: str) -> str:
     text = str(text).strip().replace("µ", "u")
     if text not in ("s", "ms", "us", "ns"):
         raise ValueError("give s, ms, us or ns (leave it out to detect it from the sample interval)")
+    return text
+
+
+def topic(text: str) -> str:
+    """The stream of a log of several (a ROS topic ``/imu0``, a ULog ``sensor_gyro:1``, a DataFlash ``IMU:1``),
+    stripped; blank text is refused."""
+    text = str(text).strip()
+    if not text:
+        raise ValueError("give the stream's name, e.g. /imu0, sensor_gyro:1 or IMU:1")
+    return text
+
+
+def stamps(text: str) -> str:
+    """Which time stamps a stream's samples carry: ``header`` (the sensor's) or ``record`` (the recorder's)."""
+    text = str(text).strip().lower()
+    if text not in ("header", "record"):
+        raise ValueError("give header (the sensor's time stamps) or record (when the recorder wrote them)")
     return text

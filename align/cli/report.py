@@ -7,7 +7,7 @@ report, COMMANDS
 """
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
@@ -88,7 +88,7 @@ def report(
     time_column: opt.TimeColumn = None,
     units: opt.UnitFlag("--units", "Unit of the static recording (--allan), as allan's --units: an angular rate or an "
                         "acceleration (deg/s, m/s^2, g), or the size of one count ('131 LSB/(deg/s)', "
-                        "'16384 LSB/g').") = "deg/s",
+                        "'16384 LSB/g')." + opt.stated_default("deg/s")) = None,
     grid: Annotated[str, typer.Option("--grid", parser=grid_value, metavar="GRID", help=(
         "Static recording's tau grid, as allan's: dense | octave | decade | explicit taus '0.01,0.1,1' (s)."))] = "dense",
     per_decade: opt.Whole("--per-decade", "Points per decade of the dense grid (1 to 1000), as allan's.", 1, 1000,
@@ -98,7 +98,7 @@ def report(
     memory_limit_mb: opt.Number("--memory-limit-mb", "Static recording: phase kept in memory up to this size (MB); "
                                 "beyond it, a temporary file (as allan's).", POSITIVE, "2000", "MB") = 2000.0,
     gyro_units: opt.GyroUnits("Unit of the rate-table log (--log); without --log and --alignment, of the static "
-                              "recording (--allan), as allan's --gyro-units.") = "deg/s",
+                              "recording (--allan), as allan's --gyro-units.", stated=True) = None,
     gyro_columns: opt.Columns("Columns of the rate-table log (--log): time,x,y,z (x,y,z with --log-rate-hz). Default "
                               "time,gyro_x,gyro_y,gyro_z; for --alignment, the columns the result records.",
                               "--gyro-columns", optional=True) = None,
@@ -118,6 +118,8 @@ def report(
     comment: opt.Comment = None,
     delimiter: opt.Delimiter = None,
     time_units: opt.TimeUnits = None,
+    topic: opt.Topic = None,
+    stamps: opt.Stamps = None,
     parts: PartsFile = None,
 ) -> None:
     """One self-contained HTML report from any subset of results: budget, allowance, alignment, noise, calibrations.
@@ -144,8 +146,8 @@ def report(
     if allan_log is not None and allan_log.suffix.lower() != ".json":  # a static record: as `allan REC` reads it
         from align.cli.allan import allan_options
 
-        if log is None and alignment is None and gyro_units != "deg/s":  # no rate-table log: as `allan --gyro-units`
-            if units != "deg/s":
+        if log is None and alignment is None and gyro_units is not None:  # no rate-table log: as `allan --gyro-units`
+            if units is not None:
                 raise InputError("give the static recording's unit once: {units} or {gyro_units} (without {log}, "
                                  "--gyro-units is the recording's, as allan's)", "{gyro_units}")
             units = gyro_units
@@ -153,15 +155,17 @@ def report(
                                    time_column=time_column, grid=grid, per_decade=per_decade, modified=modified,
                                    rate=rate, accuracy=accuracy, noise_ratio=noise_ratio,
                                    memory_limit_mb=memory_limit_mb, skip_rows=skip_rows, comment=comment,
-                                   delimiter=delimiter, time_units=time_units)
-    given = (skip_rows, comment, delimiter, time_units) != (0, None, None, None)  # else: what a result recorded
+                                   delimiter=delimiter, time_units=time_units, topic=topic, stamps=stamps)
+    fmt: dict[str, Any] = dict(skip_rows=skip_rows, comment=comment, delimiter=delimiter, time_units=time_units,
+                               topic=topic, stamps=stamps)
+    given = any(v not in (0, None) for v in fmt.values())  # else: what a result recorded
     with progress(monte_carlo if mount is not None else 0, "Monte Carlo") as tick:
         done = make_report(
             mount, manoeuvre, log=log, plan=plan, allan=allan_log, allan_columns=columns, allan_rate_hz=rate_hz,
             allan_units=units, gyro_units=gyro_units, table_rate=rate, accuracy=accuracy, monte_carlo=monte_carlo,
             basis=opt.value(basis), noise_ratio=noise_ratio, allan_options=allan_opts, log_time_column=log_time_column,
-            seed=seed, progress=tick, log_format=opt.log_format(skip_rows, comment, delimiter, time_units) if given
-            else None, alignment=alignment, calibrations=calibrations, drift=drifts, title=title, header=header,
+            seed=seed, progress=tick, log_format=opt.log_format(**fmt) if given else None, alignment=alignment,
+            calibrations=calibrations, drift=drifts, title=title, header=header,
             parts=LazyParts(parts) if mount is not None else None, log_columns=gyro_columns, log_rate_hz=log_rate_hz,
             spell=opt.speller("report", _flags()))
     with outputs() as staged:

@@ -8,7 +8,8 @@ tables read are checked by :mod:`align.io.keys`.
 
 Public names
 ------------
-existing_file, decode_text, read_text, read_toml, read_json, write_json, write_text, write_bytes, write_csv, to_json_value
+existing_file, existing_log, decode_text, read_text, read_toml, read_json, write_json, write_text, write_bytes, write_csv,
+to_json_value
 """
 
 from __future__ import annotations
@@ -33,6 +34,25 @@ def existing_file(path: str | Path) -> Path:
     if not p.is_file():
         raise InputError("file not found", str(path))
     return p
+
+
+def existing_log(path: str | Path) -> Path:
+    """``path`` as a Path: an existing file, or a folder a registered log reader claims (a ROS 2 bag, an EuRoC
+    dataset: :func:`align.io.readers.reader_for`). A plan, a result or any other input stays a file
+    (:func:`existing_file`).
+
+    Raises
+    ------
+    InputError
+        A missing path, or a folder no reader claims (naming the folder kinds there are).
+    """
+    p = Path(path)
+    if p.is_dir():
+        from align.io.readers import reader_for
+
+        reader_for(p)  # refuses a folder that is no log, naming the kinds of log folder
+        return p
+    return existing_file(p)
 
 
 def decode_text(raw: bytes, where: str) -> str:

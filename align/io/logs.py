@@ -1,7 +1,8 @@
 """Sensor logs: the one place that reads recorded data.
 
-CSV (optionally .gz, read with pyarrow), blank-separated text, .parquet, .npy and
-raw binary (columns by name: :mod:`align.io.tables`); a logger's preamble, comments,
+CSV (optionally .gz, read with pyarrow), blank-separated text, .parquet, .npy, raw
+binary and every registered format (a stream of a ROS bag, a ULog, a DataFlash log:
+:mod:`align.io.readers`; columns by name: :mod:`align.io.tables`); a logger's preamble, comments,
 delimiter and the unit of its time column (:class:`~align.io.formats.LogFormat`:
 the time unit is detected from the sample interval unless given); data converted
 to SI once, here, from a unit or the size of one count (``"131 LSB/(deg/s)"``).
@@ -94,14 +95,19 @@ class SensorLog:
 
     def inputs(self) -> dict:
         """How the file was read, for a result's ``inputs``: the format options and the time unit
-        (``time_units``, with ``time_units_detected``), the stream read (``stream``) and the unit the file
-        states (``units_stated``), when it has them."""
-        out = {**self.format.to_dict(), "time_units": self.time_units, "time_units_detected": self.time_detected}
-        if self.source:
-            out["stream"] = dict(self.source)
-        if self.stated:
-            out["units_stated"] = self.units
-        return out
+        (``time_units``, with ``time_units_detected``), and the stream and stated unit (:meth:`stream_inputs`)."""
+        return {**self.format.to_dict(), "time_units": self.time_units, "time_units_detected": self.time_detected,
+                **self.stream_inputs()}
+
+    def stream_inputs(self, prefix: str = "") -> dict:
+        """The stream read (``stream``) and the unit the file states (``units_stated``), when it has them, each key
+        after ``prefix`` (``accel_``): what a result records of a log of several streams beside its own keys."""
+        return {prefix + k: v for k, v, has in (("stream", dict(self.source), bool(self.source)),
+                                                 ("units_stated", self.units, self.stated)) if has}
+
+    def remarks(self, where: str) -> tuple[str, ...]:
+        """The reader's notes (a truncated last record left out) as a result states them: after the log's name."""
+        return tuple(f"{where}: {n}" for n in self.notes)
 
     def time_note(self) -> str | None:
         """One sentence on the time column's unit when it is not seconds (None otherwise): results state it."""
@@ -126,21 +132,11 @@ def _rate_only(fmt: LogFormat, path) -> None:
                          "leave one of them out", str(path))
 
 
-def read_sensor_log(
-    path: str | Path,
-    columns: list[str],
-    units: str | None,
-    time_column: str | None = "time",
-    rate_hz: float | None = None,
-    expect: str | None = "angular_rate",
-    log_format: LogFormat | None = None,
-    counts: bool = False,
-    field: str | None = None,
-    *,
-    default_units: str | None = None,
-    temperature_column: str | None = None,
-    temperature_units: str | None = None,
-) -> SensorLog:
+def read_sensor_log(path: str | Path, columns: list[str], units: str | None, time_column: str | None = "time",
+                    rate_hz: float | None = None, expect: str | None = "angular_rate",
+                    log_format: LogFormat | None = None, counts: bool = False, field: str | None = None, *,
+                    default_units: str | None = None, temperature_column: str | None = None,
+                    temperature_units: str | None = None) -> SensorLog:
     """Read a sensor log: time (s) and data columns converted to SI, and how the file was read.
 
     Parameters
@@ -223,15 +219,9 @@ def read_sensor_log(
                      from_file)
 
 
-def read_log(
-    path: str | Path,
-    columns: list[str],
-    units: str,
-    time_column: str | None = "time",
-    rate_hz: float | None = None,
-    expect: str | None = "angular_rate",
-    log_format: LogFormat | None = None,
-) -> tuple[np.ndarray, np.ndarray]:
+def read_log(path: str | Path, columns: list[str], units: str, time_column: str | None = "time",
+             rate_hz: float | None = None, expect: str | None = "angular_rate",
+             log_format: LogFormat | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Read a sensor log: time (s) and data columns converted to SI (:func:`read_sensor_log`, which also
     tells how the file was read).
 
@@ -325,6 +315,10 @@ class StaticLog:
         True when ``time_units`` was detected from the sample interval.
     time_step : float or None
         The median step of the time column in the file's numbers, when it was read beside a given ``rate_hz``.
+    units : str or None
+        The one unit the file states for the data columns (a ULog, a bag); None: it states none.
+    source, notes
+        The stream read and the reader's remarks (:class:`align.io.readers.Columns`).
     """
 
     data: object
@@ -332,6 +326,29 @@ class StaticLog:
     time_units: str | None
     time_detected: bool
     time_step: float | None = None
+    units: str | None = None
+    source: Mapping[str, Any] = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
+
+
+#: file endings of records read in chunks (numpy's own, raw binary) unless a registered reader claims the file
+CHUNKED = (".npy", ".bin", ".f8", ".f4", ".raw")
+
+
+def chunked(log: Path) -> bool:
+    """Whether a static record is read in chunks (:class:`NpyChunks`): a ``.npy`` file, or raw binary that no
+    registered reader owning its ending claims by its first bytes (a DataFlash ``.bin`` goes to its reader)."""
+    suffix = log.suffix.lower()
+    if suffix not in CHUNKED or suffix == ".npy":
+        return suffix == ".npy"
+    from align.io.readers import READERS
+
+    try:
+        with open(log, "rb") as fh:
+            head = fh.read(1 << 12)
+    except OSError:  # NpyChunks names the problem
+        return True
+    return not any(suffix in r.suffixes and r.sniff is not None and r.sniff(head) for r in READERS)
 
 
 def read_static_log(log: str | Path, names: list[str], rate_hz: float | None, log_format: LogFormat | None = None,
@@ -341,19 +358,21 @@ def read_static_log(log: str | Path, names: list[str], rate_hz: float | None, lo
     No unit conversion (the deviations are scaled afterwards, so no SI copy of a
     large record is made) but for ``scale``, the size of one count in the unit the
     deviations are shown in (1 for readings in a unit). ``.npy`` and raw binary files
-    come back as a :class:`NpyChunks` source read in chunks; text needs a uniform time
-    column ``time_column`` (gaps are refused with their position; its unit detected or given by
+    come back as a :class:`NpyChunks` source read in chunks (:func:`chunked`); other logs (text, Parquet, a
+    stream of a bag, ULog or DataFlash log, whose units and time unit the file states) need a uniform time
+    column ``time_column`` (gaps are refused with their position; its unit stated, detected or given by
     ``log_format``) unless ``rate_hz`` is given. With ``rate_hz`` and ``time_step``, the time column is read
     too (not checked) and its median step, in the file's numbers, returned as ``time_step`` (a caller compares
     it with ``rate_hz``).
     """
     log = Path(log)
     fmt = log_format or LogFormat()
-    if log.suffix.lower() in (".npy", ".bin", ".f8", ".f4", ".raw"):
+    if chunked(log):
         rate = _check_rate(rate_hz, log, f"a {log.suffix} file has no time: give {{rate_hz}}")
-        if fmt.given():
-            raise InputError(f"{', '.join('{' + k + '}' for k in fmt.given())} apply to text logs, not to a "
-                             f"{log.suffix} file; leave them out", str(log))
+        if fmt.given() or fmt.streams_given():
+            given = fmt.given() + fmt.streams_given()
+            raise InputError(f"{', '.join('{' + k + '}' for k in given)} apply to text logs or logs of several "
+                             f"streams, not to a {log.suffix} file; leave them out", str(log))
         _rate_only(fmt, log)
         source = NpyChunks(log, len(names), scale)
         if source.shape[1] != len(names):
@@ -365,24 +384,25 @@ def read_static_log(log: str | Path, names: list[str], rate_hz: float | None, lo
     if rate_hz is not None:
         _check_rate(rate_hz, log)
         _rate_only(fmt, log)
-    if rate_hz is not None and time_step:
-        _, data = read_columns(log, [time_column] + names, time_column, fmt)
-        head = data[:100_001, 0]
-        step = float(np.median(np.diff(head))) if len(head) > 1 else None
-        data = np.ascontiguousarray(data[:, 1:])
-        check_readings(data, str(log))
-        return StaticLog(data * scale if scale != 1 else data, float(rate_hz), None, False, step)
-    wanted = names if rate_hz is not None else [time_column] + names
-    _, data = read_columns(log, wanted, None if rate_hz is not None else time_column, fmt)
+    with_time = rate_hz is None or time_step
+    got = read_table(log, ([time_column] if with_time else []) + names, time_column if with_time else None, fmt)
+    stated = (got.unit(names), dict(got.source), tuple(got.notes))
+    data = got.data
     if rate_hz is not None:
-        check_readings(data, str(log))
-        return StaticLog(data * scale if scale != 1 else data, float(rate_hz), None, False)
+        head = data[:100_001, 0] if time_step else data[:0, 0]
+        step = float(np.median(np.diff(head))) if len(head) > 1 else None
+        values = np.ascontiguousarray(data[:, 1:] if time_step else data)
+        check_readings(values, str(log))
+        return StaticLog(values * scale if scale != 1 else values, float(rate_hz), None, False, step, *stated)
     check_readings(data[:, 1:], str(log), data[:, 0])
-    t, unit, detected = _time_of(data[:, 0], time_column, str(log), fmt)
+    said = got.units.get(time_column)
+    t, unit, detected = _time_of(data[:, 0], time_column, str(log),
+                                 replace(fmt, time_units=said) if fmt.time_units is None and said in TIME_UNITS else fmt)
     check_log(t, data[:, 1:], str(log), min_rows=3)
     check_time(t, str(log), gap=1.5, jitter=True)  # an Allan deviation needs uniform samples
     values = np.ascontiguousarray(data[:, 1:])
-    return StaticLog(values * scale if scale != 1 else values, 1.0 / float(np.median(np.diff(t))), unit, detected)
+    return StaticLog(values * scale if scale != 1 else values, 1.0 / float(np.median(np.diff(t))), unit, detected,
+                     None, *stated)
 
 
 def read_static(log: str | Path, names: list[str], rate_hz: float | None, log_format: LogFormat | None = None):

@@ -199,7 +199,7 @@ def reader_for(path: Path, log_format: LogFormat | None = None) -> LogReader:
     if owned:
         longest = max(n for n, _ in owned)
         mine = [r for n, r in owned if n == longest]
-        if len(mine) == 1:
+        if len(mine) == 1:  # its reader says so when the file is not of its format (a raw float64 .bin)
             return mine[0]
         for r in mine:  # one suffix, several formats (.bin): by content
             if r.sniff is not None and r.sniff(head):

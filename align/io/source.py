@@ -15,7 +15,7 @@ option means the same on every command:
 
 Public names
 ------------
-LogSource, column_names, check_distinct, DEFAULT_TIME
+LogSource, column_names, check_distinct, DEFAULT_TIME, STREAM_COLUMNS
 """
 
 from __future__ import annotations
@@ -30,10 +30,14 @@ from align.io.formats import LogFormat
 from align.io.logs import SensorLog, read_sensor_log
 from align.vocab import Sensor
 
-__all__ = ["LogSource", "column_names", "check_distinct", "DEFAULT_TIME"]
+__all__ = ["LogSource", "column_names", "check_distinct", "DEFAULT_TIME", "STREAM_COLUMNS"]
 
 #: the time column's name when none is given
 DEFAULT_TIME = "time"
+#: the columns a reader of several streams (a bag, a ULog, DataFlash) or of a log folder names, by the one convention
+#: (:mod:`align.io.readers`): time in s, gyro, accelerometer (an old default name of the accelerometer), magnetometer
+STREAM_COLUMNS = (DEFAULT_TIME, *Sensor.GYROSCOPE.columns, "accel_x", "accel_y", "accel_z", *Sensor.MAGNETOMETER.columns,
+                  "temperature")
 
 
 def _names(columns: str | Sequence[str]) -> list[str]:
@@ -154,7 +158,8 @@ class LogSource:
         return column_names(self.columns, self.time_column, self.rate_hz, defaults or sensor.columns, field)
 
     def read(self, sensor: Sensor, *, expect: str | None = None, counts: bool = False, field: str | None = None,
-             defaults: Sequence[str] | None = None, columns_field: str = "columns") -> SensorLog:
+             defaults: Sequence[str] | None = None, columns_field: str = "columns",
+             default_units: str | None = None) -> SensorLog:
         """The readings of ``sensor``: time in s, data in SI (or counts), and how the file was read.
 
         With no columns given, the sensor's default names are read, or the first set of its old default
@@ -173,6 +178,8 @@ class LogSource:
             Data columns when none are given (default: the sensor's).
         columns_field : str
             The option that gave the columns, for messages.
+        default_units : str, optional
+            The unit when neither :attr:`units` nor the file gives one (default: the sensor's, ``deg/s``, ...).
 
         Returns
         -------
@@ -189,7 +196,7 @@ class LogSource:
                              "{temperature_column}")
         return read_sensor_log(self.path, cols, self.units, time, self.rate_hz, expect=expect, log_format=self.format,
                                counts=counts, field=field or ("gyro_units" if sensor is Sensor.GYROSCOPE else "units"),
-                               default_units=sensor.unit, temperature_column=self.temperature_column,
+                               default_units=default_units or sensor.unit, temperature_column=self.temperature_column,
                                temperature_units=self.temperature_units)
 
     def data_names(self, sensor: Sensor, field: str = "columns") -> list[str]:
@@ -209,12 +216,15 @@ class LogSource:
 
     def header(self) -> list[str] | None:
         """The column names of the file (None for a format without names, or a file that cannot be read:
-        the reader then says why)."""
+        the reader then says why); for a log of several streams or a log folder, the names of the one
+        convention (:data:`STREAM_COLUMNS`: its reader names what it reads so)."""
         try:
             from align.io.readers import reader_for
 
             p = self.path
             reader = reader_for(p, self.format)
+            if reader.streams or reader.folder:
+                return list(STREAM_COLUMNS)
             if reader.name == "parquet":
                 import pyarrow.parquet as pq
 

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from align.errors import InputError
-from align.io.files import existing_file
+from align.io.files import existing_log
 from align.io.formats import LogFormat, content_lines, csv_source, preamble_hint
 
 
@@ -61,7 +61,7 @@ def read_table(path: str | Path, names: list[str] | None = None, time_column: st
     from align.io.readers import Columns, reader_for
 
     p = Path(path)
-    p = p if p.is_dir() else existing_file(path)
+    p = existing_log(path)
     fmt = log_format or LogFormat()
     reader = reader_for(p, fmt)
     if not reader.text and fmt.given():

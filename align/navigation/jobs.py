@@ -68,11 +68,12 @@ class DriftOptions:
         A manoeuvre TOML (``[[rotation]]`` or ``[series]``); static mission when None.
     trajectory : LogSource or None
         A recorded log as the true motion (instead of ``manoeuvre``): its gyro columns, time column or rate,
-        gyro unit and format.
+        gyro unit (None: the unit the file states, else deg/s) and format.
     accel_columns : tuple of str or None
         The accelerometer columns of ``trajectory`` (None: the accelerometer's default names).
-    accel_units : str
-        Unit of the accelerometer columns of ``trajectory`` (``"m/s^2"``, ``"g"``).
+    accel_units : str or None
+        Unit of the accelerometer columns of ``trajectory`` (``"m/s^2"``, ``"g"``); None: the unit the file
+        states, else m/s^2.
     runs : int
         Monte Carlo runs, 2 to :data:`MAX_RUNS`.
     rate_hz : float
@@ -108,7 +109,7 @@ class DriftOptions:
     manoeuvre: Path | None = None
     trajectory: LogSource | None = None
     accel_columns: tuple[str, ...] | None = None
-    accel_units: str = "m/s^2"
+    accel_units: str | None = None
     runs: int = 1000
     rate_hz: float = 100.0
     nav_rate: float | None = None
@@ -170,11 +171,14 @@ class DriftInputs:
         The residual sensor errors and where each came from.
     inputs : dict
         The files and figures, as the result records them.
+    notes : tuple of str
+        The trajectory reader's remarks (a truncated last record), after its file.
     """
 
     mission: Mission
     errors: ResidualErrors
     inputs: dict
+    notes: tuple[str, ...] = ()
 
 
 def _read_correction(path: Path) -> Any:
@@ -193,8 +197,9 @@ def _read_budget(options: DriftOptions) -> Any:
     return budget(read_mount(BudgetOptions(mount=options.budget, parts_table=options.table())))
 
 
-def _trajectory(options: DriftOptions, settings: dict[str, Any]) -> Mission:
-    """A recorded log as the mission's true motion: its readings from the attitude levelled on its first second."""
+def _trajectory(options: DriftOptions, settings: dict[str, Any]) -> tuple[Mission, dict[str, Any], tuple[str, ...]]:
+    """A recorded log as the mission's true motion: its readings from the attitude levelled on its first second;
+    what the result records of the log read (units, stream) and the reader's remarks."""
     from align.navigation.mission import recorded_mission
     from align.navigation.strapdown import level_attitude
 
@@ -222,9 +227,13 @@ def _trajectory(options: DriftOptions, settings: dict[str, Any]) -> Mission:
                              "{duration}")
     first = max(1, min(n, int(round(LEVEL_TIME * gyr.rate_hz))))
     q0 = level_attitude(acc.data[:first].mean(axis=0), options.heading)
-    return recorded_mission(gyr.data[:n], acc.data[:n], gyr.rate_hz, q0, description=(
+    mission = recorded_mission(gyr.data[:n], acc.data[:n], gyr.rate_hz, q0, description=(
         f"recorded trajectory {path.name}, {n:,} samples at {gyr.rate_hz:g} Hz, initial attitude levelled on its first "
         f"{first / gyr.rate_hz:g} s"), latitude=settings["latitude"], earth_rate=settings["earth_rate"])
+    said = {**gyr.stream_inputs("trajectory_"), **acc.stream_inputs("trajectory_accel_")}
+    if acc.source == gyr.source:
+        said.pop("trajectory_accel_stream", None)
+    return mission, said, tuple(dict.fromkeys(gyr.remarks(str(path)) + acc.remarks(str(path))))  # one file: once
 
 
 def read(options: DriftOptions) -> DriftInputs:
@@ -246,8 +255,10 @@ def read(options: DriftOptions) -> DriftInputs:
         where={"allan": [str(p) for p in allan], "correction": str(options.alignment), "budget": str(options.budget)},
         mount_error=options.mount_error)
     settings: dict[str, Any] = dict(heading=options.heading, latitude=options.latitude, earth_rate=options.earth_rate)
+    said: dict[str, Any] = {}
+    notes: tuple[str, ...] = ()
     if options.trajectory is not None:
-        mission = _trajectory(options, settings)
+        mission, said, notes = _trajectory(options, settings)
     elif options.manoeuvre is None:
         assert options.duration is not None
         mission = static_mission(options.duration, options.rate_hz, **settings)
@@ -262,7 +273,7 @@ def read(options: DriftOptions) -> DriftInputs:
         "manoeuvre": options.manoeuvre and str(options.manoeuvre),
         "trajectory": trajectory and str(trajectory.path),
         "mount_error": options.budget and options.mount_error}.items() if v}
-    return DriftInputs(mission, errors, inputs)
+    return DriftInputs(mission, errors, {**inputs, **said}, notes)
 
 
 def compute(inputs: DriftInputs, options: DriftOptions, progress: Progress | None = None) -> DriftResult:
@@ -270,8 +281,9 @@ def compute(inputs: DriftInputs, options: DriftOptions, progress: Progress | Non
     (:func:`align.navigation.drift.drift`); ``progress`` is called with the runs done."""
     from align.navigation.drift import drift as analyse
 
-    return analyse(inputs.mission, inputs.errors, options.runs, options.seed, options.nav_rate, inputs=inputs.inputs,
-                   progress=progress, flicker_span=options.flicker_span)
+    result = analyse(inputs.mission, inputs.errors, options.runs, options.seed, options.nav_rate, inputs=inputs.inputs,
+                     progress=progress, flicker_span=options.flicker_span)
+    return result.replace(notes=tuple(result.notes) + inputs.notes) if inputs.notes else result
 
 
 def files(options: DriftOptions) -> dict[str, Path | None]:

@@ -54,7 +54,7 @@ MIN_SAMPLES = 100
 #: the keys of an Allan file after its envelope (a misspelled key is refused, not ignored)
 FILE_KEYS = ("sensor", "fs_hz", "samples", "runs", "tau", "m", "adev", "ci_low", "ci_high", "fit", "figures", "periods_s",
              "adev_run_figures", "inputs", "mdev", "adev_of", "repeatability", "plan", "noise_type_alpha", "edf",
-             "edf_mdev", "pooled", "per_run")
+             "edf_mdev", "pooled", "per_run", "streams", "notes")
 
 
 class AllanAnalysis(Result, format=FORMAT, convention=CONVENTION, version=2):
@@ -83,6 +83,10 @@ class AllanAnalysis(Result, format=FORMAT, convention=CONVENTION, version=2):
         Each run's own curve (with its bias figures) when there are several; empty for one run.
     run_fits : tuple of tuple of NoiseFit
         Each run's fits, one per channel, when there are several.
+    streams : tuple of dict
+        The stream each record was read from, for a log of several (topic, instance, device id); empty otherwise.
+    notes : tuple of str
+        The readers' remarks (a truncated last record left out).
     """
 
     result: AllanResult
@@ -95,10 +99,12 @@ class AllanAnalysis(Result, format=FORMAT, convention=CONVENTION, version=2):
     plan: PlanResult | None = None
     run_results: tuple = ()
     run_fits: tuple = ()
+    streams: tuple = ()
+    notes: tuple = ()
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        for name in ("fits", "figures", "inputs", "run_results"):
+        for name in ("fits", "figures", "inputs", "run_results", "streams", "notes"):
             object.__setattr__(self, name, tuple(getattr(self, name)))
         object.__setattr__(self, "run_fits", tuple(tuple(f) for f in self.run_fits))
 
@@ -140,6 +146,10 @@ class AllanAnalysis(Result, format=FORMAT, convention=CONVENTION, version=2):
                             for k, (rr, fits) in enumerate(zip(self.run_results, self.run_fits))]
         if self.plan is not None:
             d["plan"] = self.plan.to_dict()
+        if self.streams:
+            d["streams"] = [dict(x) for x in self.streams]
+        if self.notes:
+            d["notes"] = [str(x) for x in self.notes]
         return d
 
     @classmethod
@@ -167,7 +177,8 @@ class AllanAnalysis(Result, format=FORMAT, convention=CONVENTION, version=2):
             return cls(result, fits, figures, None if rep is None else np.array([rep[k] for k in names], dtype=float) * f,
                        u, runs, tuple(d.get("inputs", ())),
                        PlanResult.from_dict(d["plan"], f"{where}: plan") if "plan" in d else None,
-                       tuple(p[0] for p in per), tuple(p[1] for p in per))
+                       tuple(p[0] for p in per), tuple(p[1] for p in per),
+                       tuple(dict(x) for x in d.get("streams", ())), tuple(str(x) for x in d.get("notes", ())))
         except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
             raise InputError(f"malformed {FORMAT} result ({malformed(exc)}); regenerate it", where) from None
 

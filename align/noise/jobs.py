@@ -42,8 +42,8 @@ class AllanOptions:
     Attributes
     ----------
     logs : tuple of Path
-        Static recordings of one sensor (``.csv``, ``.csv.gz``, ``.parquet``, ``.npy``, raw float64 ``.bin``);
-        several are several runs, pooled.
+        Static recordings of one sensor (``.csv``, ``.csv.gz``, ``.parquet``, ``.npy``, raw float64 ``.bin``, a
+        stream of a log of several: ``format.topic``); several are several runs, pooled.
     columns : tuple of str or None
         Data columns, C of them (three for x, y, z; four names keep meaning "time first"). None:
         ``gyro_x, gyro_y, gyro_z`` (or the old default names the file has).
@@ -52,12 +52,13 @@ class AllanOptions:
     rate_hz : float or None
         Sample rate, Hz, for records without a time column (``.npy`` always). A text record's time
         column, when it has one, must agree with it.
-    gyro_units : str
-        Unit of the readings, an angular rate (``"deg/s"``) or the size of one count (``"131 LSB/(deg/s)"``).
+    gyro_units : str or None
+        Unit of the readings, an angular rate (``"deg/s"``) or the size of one count (``"131 LSB/(deg/s)"``);
+        None: the unit the file states (a ULog, a bag), else deg/s.
     units : str or None
         Any rate or acceleration unit (or count size) instead of ``gyro_units`` (``"g"``, ``"16384 LSB/g"``).
     format : LogFormat
-        Preamble, comments, delimiter and time unit of a text record.
+        Preamble, comments, delimiter and time unit of a text record; the topic of a log of several streams.
     grid : str or tuple of float
         ``"dense"``, ``"octave"``, ``"decade"`` or explicit taus, s.
     per_decade : int
@@ -80,7 +81,7 @@ class AllanOptions:
     columns: tuple[str, ...] | None = None
     time_column: str | None = None
     rate_hz: float | None = None
-    gyro_units: str = "deg/s"
+    gyro_units: str | None = None
     units: str | None = None
     format: LogFormat = field(default_factory=LogFormat)
     grid: str | tuple[float, ...] = "dense"
@@ -109,8 +110,8 @@ class AllanOptions:
         return "gyro_units" if self.units is None else "units"
 
     @property
-    def typed_units(self) -> str:
-        """The unit of the readings as typed."""
+    def typed_units(self) -> str | None:
+        """The unit of the readings as typed (None: none typed)."""
         return self.gyro_units if self.units is None else self.units
 
 
@@ -131,6 +132,10 @@ def compute_allan(inputs: AllanInputs, options: AllanOptions, progress: Progress
                        options.modified, periods=options.periods, progress=progress, memory_limit=options.memory_limit,
                        where=list(inputs.files))
     result = result.replace(inputs=inputs.files)
+    said = {"streams": inputs.streams, "notes": inputs.notes}  # the records' streams and readers' remarks, where the
+    said = {k: v for k, v in said.items() if v and k in type(result).__dataclass_fields__}  # result type holds them
+    if said:
+        result = result.replace(**said)
     if options.rate is not None and options.accuracy is not None:
         result = result.replace(plan=plan_from_allan(result, options.rate, options.accuracy, options.noise_ratio,
                                                      "measured curve (worst channel)"))

@@ -1,7 +1,8 @@
 """Static records for the Allan deviation: read through the one static reader, and checked.
 
 :func:`read_records` reads each record with :func:`align.io.read_static_log` (``.csv``, ``.csv.gz``,
-``.parquet``, ``.npy`` and raw binary, the last two in chunks), by the one column convention
+``.parquet``, ``.npy`` and raw binary, the last two in chunks, and a stream of every registered format of
+several: its unit and time as the file states them), by the one column convention
 (:func:`allan_columns`), and refuses, naming the file and the option, what an Allan deviation cannot use
 (:func:`check_static`): a moving sensor (a rate-table session), an accelerometer that reads gravity in
 another unit than the one given (g read as m/s^2), raw counts read as a rate; and
@@ -61,6 +62,11 @@ class AllanInputs:
         The records, as given.
     time_notes : tuple of str
         How each text record's time column was read, when not in seconds.
+    streams : tuple of dict
+        Per record, the stream read and the unit the file states (``stream``, ``units_stated``; empty for a
+        record of one stream that states none).
+    notes : tuple of str
+        The readers' remarks (a truncated last record), each after its file.
     """
 
     runs: tuple
@@ -69,6 +75,8 @@ class AllanInputs:
     unit: str
     files: tuple[str, ...]
     time_notes: tuple[str, ...] = ()
+    streams: tuple[dict, ...] = ()
+    notes: tuple[str, ...] = ()
 
     @property
     def samples(self) -> int:
@@ -76,10 +84,10 @@ class AllanInputs:
         return int(sum(r.shape[0] for r in self.runs))
 
 
-def allan_unit(gyro_units: str = "deg/s", units: str | None = None) -> tuple[str, float]:
+def allan_unit(gyro_units: str | None = "deg/s", units: str | None = None) -> tuple[str, float]:
     """The unit the deviations are shown in, and the size of one count in it (1: the logs hold that unit).
 
-    ``gyro_units`` is an angular rate, ``units`` an angular rate or an acceleration; either may be the
+    ``gyro_units`` is an angular rate (None: deg/s), ``units`` an angular rate or an acceleration; either may be the
     size of one count (``'0.0076336 deg/s'``, ``'131 LSB/(deg/s)'``, ``'16384 LSB/g'``): the deviations are
     then shown in deg/s or m/s^2. Raw ``counts`` are refused with the advice to give the count size.
 
@@ -99,7 +107,7 @@ def allan_unit(gyro_units: str = "deg/s", units: str | None = None) -> tuple[str
     from align.io import sensor_scale
 
     if units is None:
-        factor, shown = sensor_scale(gyro_units, "angular_rate", "gyro_units")
+        factor, shown = sensor_scale(gyro_units or Sensor.GYROSCOPE.unit, "angular_rate", "gyro_units")
         return shown, factor / parse_unit(shown).factor
     for expect in ("angular_rate", "acceleration"):
         try:
@@ -292,6 +300,17 @@ def _check_time(got: Any, options: AllanOptions, time_name: str, where: str) -> 
                 f"really at {got.rate_hz / 1e3:.4g} kHz: give {{rate_hz}} without {{time_units}})", where)
 
 
+def _stated_unit(stated: str, options: AllanOptions, where: str) -> str:
+    """The unit a record states (a ULog's, a bag's), as the deviations are shown in; a unit typed that disagrees
+    is refused naming its option (:func:`align.io.readings.units_of`)."""
+    from align.io.readings import units_of
+
+    rate = parse_unit(stated).dim == DIMENSIONS["angular_rate"][0].dim
+    units_of(options.units if options.units is not None else options.gyro_units, stated, None,
+             "angular_rate" if rate else "acceleration", options.unit_field, where)
+    return allan_unit(units=stated)[0]
+
+
 def read_records(options: AllanOptions) -> AllanInputs:
     """Read and check the static records of an ``allan`` job.
 
@@ -315,6 +334,7 @@ def read_records(options: AllanOptions) -> AllanInputs:
         A gyro mean rate no gyro at rest reads (raw counts read as a rate).
     """
     from align.io import read_static_log
+    from align.io.logs import chunked
 
     if (options.rate is None) != (options.accuracy is None):
         raise InputError("give both {rate} and {accuracy} to plan", "{rate}" if options.rate is None else "{accuracy}")
@@ -324,13 +344,13 @@ def read_records(options: AllanOptions) -> AllanInputs:
     sensor = Sensor.GYROSCOPE if parse_unit(unit).dim == DIMENSIONS["angular_rate"][0].dim else Sensor.ACCELEROMETER
     fmt = options.format
     time_name = _time_name(options)
-    runs, files, notes = [], [], []
+    runs, files, notes, streams, remarks = [], [], [], [], []
     fs: float | None = None
     names: list[str] | None = None
+    shown: str | None = None
     for path in options.logs:
         where = str(path)
-        binary = path.suffix.lower() in (".npy", ".bin", ".f8", ".f4", ".raw")
-        header = None if binary else LogSource(path=path, format=fmt).header()
+        header = None if chunked(path) else LogSource(path=path, format=fmt).header()  # a DataFlash .bin has one
         _, cols = allan_columns(options.columns, options.time_column, options.rate_hz, header, sensor)
         if names is not None and cols != names:
             raise InputError(f"holds columns {', '.join(cols)}, the first run {', '.join(names)}", where)
@@ -341,11 +361,20 @@ def read_records(options: AllanOptions) -> AllanInputs:
         if fs is not None and abs(got.rate_hz - fs) > 1e-9 * fs:
             raise InputError(f"sample rate {got.rate_hz:g} Hz differs from the first run's {fs:g} Hz", where)
         fs = got.rate_hz
-        check_static(got.data, fs, cols, unit, options.typed_units, options.unit_field, where)
+        mine = unit if got.units is None else _stated_unit(got.units, options, where)
+        if shown is not None and mine != shown:
+            raise InputError(f"holds readings in {literal(mine)}, the first run in {literal(shown)}; give runs of one "
+                             "unit", where)
+        shown = mine
+        check_static(got.data, fs, cols, mine, options.typed_units or mine, options.unit_field, where)
+        streams.append({**({"stream": dict(got.source)} if got.source else {}),
+                        **({"units_stated": got.units} if got.units is not None else {})})
+        remarks += [f"{where}: {n}" for n in got.notes]
         if got.time_units not in (None, "s"):
             how = "detected from the median step" if got.time_detected else "as given"
             notes.append(f"{where}: time column read in {got.time_units} ({how}: {fs:.6g} Hz)")
         runs.append(got.data)
         files.append(where)
-    assert fs is not None  # at least one record was read
-    return AllanInputs(tuple(runs), float(fs), tuple(names or ()), unit, tuple(files), tuple(notes))
+    assert fs is not None and shown is not None  # at least one record was read
+    return AllanInputs(tuple(runs), float(fs), tuple(names or ()), shown, tuple(files), tuple(notes),
+                       tuple(streams) if any(streams) else (), tuple(remarks))

@@ -152,7 +152,7 @@ def manoeuvre_job(rep: Report, manoeuvre: Path | None, budget=None, mount=None, 
     return allow
 
 
-def _log_source(rep: Report, log: Path, gyro_units: str, log_format: LogFormat | None, columns: str | None,
+def _log_source(rep: Report, log: Path, gyro_units: str | None, log_format: LogFormat | None, columns: str | None,
                  rate_hz: float | None, time_column: str | None = None):
     """The rate-table log as the report's options give it, as ``matrix`` takes it (:class:`~align.io.source.LogSource`:
     ``x,y,z`` with the time column ``time_column`` or ``time``, or ``time,x,y,z``; ``x,y,z`` with a sample rate)."""
@@ -179,7 +179,7 @@ def _as_shown(r, shown: dict):
 
 
 def alignment_job(rep: Report, allow, log: Path | None = None, plan: Path | None = None, result: Path | None = None,
-                  gyro_units: str = "deg/s", log_format: LogFormat | None = None, columns: str | None = None,
+                  gyro_units: str | None = None, log_format: LogFormat | None = None, columns: str | None = None,
                   rate_hz: float | None = None, time_column: str | None = None) -> None:
     """The electronic alignment from a log and its plan (the ``matrix`` job, :data:`align.alignment.jobs.MATRIX`),
     or from a result file; the measured misalignment against the allowance (:mod:`align.present.measured`).
@@ -260,7 +260,7 @@ def _measured(rep: Report, r, allow) -> None:
 
 
 def allan_job(rep: Report, allan: Path, columns: str | None = None, rate_hz: float | None = None,
-              units: str | None = "deg/s", table_rate: str = "100 deg/s", accuracy: str = "0.1 deg",
+              units: str | None = None, table_rate: str = "100 deg/s", accuracy: str = "0.1 deg",
               noise_ratio: float = 10.0, log_format: LogFormat | None = None, *, options=None) -> None:
     """The Allan deviation of a static record (or an Allan result file), and the test plan from it (gyro data).
 

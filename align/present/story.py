@@ -117,7 +117,7 @@ class Outcome:
 
 def make_report(mount: Path | None = None, manoeuvre: Path | None = None, log: Path | None = None,
                 plan: Path | None = None, allan: Path | None = None, allan_columns: str = "gyro_x,gyro_y,gyro_z",
-                allan_rate_hz: float | None = None, allan_units: str = "deg/s", gyro_units: str = "deg/s",
+                allan_rate_hz: float | None = None, allan_units: str | None = None, gyro_units: str | None = None,
                 table_rate: str = "100 deg/s", accuracy: str = "0.1 deg", noise_ratio: float = 10.0,
                 monte_carlo: int = 100_000, seed: int = 0, basis: str = "rss", progress=None,
                 title: str | None = None, source: Callable[[Path], Path] | None = None,

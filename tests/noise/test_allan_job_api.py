@@ -64,7 +64,8 @@ def test_white_noise_found_within_its_interval_with_the_provenance(folder):
     (f,) = prov.files
     assert f.role == "log" and f.path == str(rec) and f.size == rec.stat().st_size
     assert f.sha256 == hashlib.sha256(rec.read_bytes()).hexdigest()
-    assert prov.options["logs"] == [str(rec)] and prov.options["gyro_units"] == "deg/s"
+    # no unit typed (None: the unit the file states, else deg/s); the unit used is the result's
+    assert prov.options["logs"] == [str(rec)] and prov.options["gyro_units"] is None and res.units == "deg/s"
     assert d["provenance"]["job"] == "allan" and d["inputs"] == [str(rec)]
 
 

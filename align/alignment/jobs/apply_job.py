@@ -44,21 +44,23 @@ class ApplyOptions:
     ----------
     log : LogSource
         The log to correct (a str or Path: the sensor's default columns and time column). Its ``units``, when
-        given, is the unit of the readings (field ``units``); None: ``gyro_units`` for a gyro result, the
-        result's own unit otherwise. Its ``columns``, None: the sensor's default names.
+        given, is the unit of the readings (field ``units``); None: ``gyro_units`` for a gyro result, else the
+        unit the file states (a ULog, a bag), else deg/s for a gyro and the result's own unit otherwise. Its
+        ``columns``, None: the sensor's default names.
     alignment : Path
         A result of ``matrix``, ``calibrate ferraris``, ``calibrate accel``, ``calibrate gyro`` or
         ``calibrate mag``.
     sensor : Sensor or None
         The sensor to correct, for a result holding several (a word is parsed: ``"accel"``); None: its only one.
-    gyro_units : str
-        Unit of a gyro log when ``log.units`` is None (a rate unit, or the size of one count).
+    gyro_units : str or None
+        Unit of a gyro log when ``log.units`` is None (a rate unit, or the size of one count); None: the unit the
+        file states, else deg/s.
     """
 
     log: LogSource
     alignment: Path
     sensor: Sensor | str | None = None
-    gyro_units: str = Sensor.GYROSCOPE.unit
+    gyro_units: str | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "log", source(self.log))
@@ -113,16 +115,18 @@ def _dimension_of(unit: str) -> Any:
     return parse_unit(unit).dim
 
 
-def _log_unit(options: ApplyOptions, correction: Any, kind: Sensor) -> tuple[str, str, str]:
-    """The unit the log is read in, the option that gave it, and the dimension expected (``"counts"`` for a result in
-    counts); a unit of another dimension than the result's is refused naming the option."""
-    where = str(options.alignment)
+def _typed_unit(options: ApplyOptions, kind: Sensor) -> tuple[str | None, str]:
+    """The unit typed for the log (None: the file's, else the default) and the option that gives it."""
     if options.log.units:
-        unit, field = options.log.units, "units"
-    elif kind is Sensor.GYROSCOPE:
-        unit, field = options.gyro_units, "gyro_units"
-    else:
-        unit, field = correction.units, "units"
+        return options.log.units, "units"
+    if kind is Sensor.GYROSCOPE:
+        return options.gyro_units, "gyro_units"
+    return None, "units"
+
+
+def _log_unit(unit: str, field: str, where: str, correction: Any, kind: Sensor) -> str:
+    """The dimension the log is read in (``"counts"`` for a result in counts) for a unit ``unit`` given by
+    ``field``; a unit of another dimension than the result's is refused naming the option."""
     expect = kind.dimension
     try:
         own = _dimension_of(correction.units)
@@ -136,12 +140,12 @@ def _log_unit(options: ApplyOptions, correction: Any, kind: Sensor) -> tuple[str
     except AlignError:  # a count size or a sensitivity ('16384 LSB/g'): read below, against the result's kind
         given = own if own != counts else None
     if given == counts and own != counts:
-        return unit, field, expect  # the log reader asks for the size of one count
+        return expect  # the log reader asks for the size of one count
     if given != own:
         raise UnitError(f"'{literal(unit)}' is not a unit of the {kind} data of {literal(where)} "
                         f"({literal(correction.units)}); give the log's unit, e.g. {{{field}={correction.units}}}",
                         "{" + field + "}")
-    return unit, field, expect
+    return expect
 
 
 def _still_blocks(x: np.ndarray, fs: float) -> tuple[np.ndarray, np.ndarray]:
@@ -215,11 +219,16 @@ def read_apply(options: ApplyOptions) -> ApplyInputs:
     sensor = None if options.sensor is None else Sensor.parse(options.sensor).value
     correction = load_result(options.alignment).correction(sensor, where)
     kind = Sensor.parse(correction.sensor)
-    unit, field, expect = _log_unit(options, correction, kind)
-    check_unit_given(unit, expect, field)
-    src = replace(options.log, units=unit)
+    typed, field = _typed_unit(options, kind)
+    default = Sensor.GYROSCOPE.unit if kind is Sensor.GYROSCOPE else correction.units
+    expect = _log_unit(typed or default, field, where, correction, kind)
+    check_unit_given(typed, expect, field)
+    src = replace(options.log, units=typed)
     time, cols = names_read(src, kind)
-    got = src.read(kind, expect=expect, counts=expect == "counts", field=field)
+    got = src.read(kind, expect=expect, counts=expect == "counts", field=field, default_units=default)
+    unit = got.units
+    if got.stated:  # the unit the file states, against the result's
+        _log_unit(unit, field, where, correction, kind)
     log = str(src.path)
     corrected = np.asarray(correction.correct(got.data))
     if expect == "counts":  # a calibration in counts makes accelerometer and gyro readings physical (SI)
@@ -247,6 +256,7 @@ def compute_apply(inputs: ApplyInputs, options: ApplyOptions, progress: Progress
     notes = [got.time_note()]
     if inputs.written != inputs.units:
         notes.append(f"readings in {inputs.units} made physical by the calibration: written in {inputs.written}")
+    notes += got.remarks(str(options.log.path))
     columns = tuple(([inputs.time_column] if inputs.time_column else []) + list(inputs.columns))
     src = options.log
     result = CorrectedLog(

@@ -10,7 +10,7 @@ TWO_AXIS_VARIANTS, MatrixOptions, MatrixInputs, read_matrix, compute_matrix, mat
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -41,7 +41,8 @@ class MatrixOptions:
     ----------
     log : LogSource
         The rate-table gyro log (a str or Path is read with the defaults: columns ``gyro_x,gyro_y,gyro_z``,
-        time column ``time``, unit deg/s). Its ``units`` is the gyro unit (None: deg/s).
+        time column ``time``, the unit the file states, else deg/s). Its ``units`` is the gyro unit (None: the
+        unit the file states, a ULog's or a bag's, else deg/s; one that disagrees with the file's is refused).
     plan : Path
         Test plan TOML: ``[[step]]`` tables (axis, rate or angle), optional ``[mounting]`` and ``[test]``.
     method : str
@@ -90,8 +91,7 @@ class MatrixOptions:
     earth: bool = True
 
     def __post_init__(self) -> None:
-        log = source(self.log)
-        object.__setattr__(self, "log", log if log.units is not None else replace(log, units=Sensor.GYROSCOPE.unit))
+        object.__setattr__(self, "log", source(self.log))
         object.__setattr__(self, "plan", Path(self.plan))
         if self.segments is not None:
             object.__setattr__(self, "segments", Path(self.segments))
@@ -165,10 +165,10 @@ def compute_matrix(inputs: MatrixInputs, options: MatrixOptions, progress: Progr
     result = align(got.t, got.data, inputs.plan, options.align_options(), inputs.segments, got.shown, str(src.path))
     columns = ",".join(([inputs.time_column] if inputs.time_column else []) + list(inputs.columns))
     result = result.replace(
-        inputs={"log": str(src.path), "plan": str(options.plan), "gyro_units": src.units or Sensor.GYROSCOPE.unit,
+        inputs={"log": str(src.path), "plan": str(options.plan), "gyro_units": got.units,
                 "columns": columns, "segments": None if options.segments is None else str(options.segments),
                 "rate_hz": src.rate_hz, "time_column": inputs.time_column, **got.inputs()},
-        notes=result.notes + tuple(filter(None, [got.time_note()])))
+        notes=result.notes + tuple(filter(None, [got.time_note()])) + got.remarks(str(src.path)))
     if progress is not None:
         progress(len(got.t))
     return result

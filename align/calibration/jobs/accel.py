@@ -14,7 +14,14 @@ from pathlib import Path
 from typing import Any
 
 from align.calibration.accel import StaticDetector
-from align.calibration.jobs.common import detector_dict, log_source, read_sensor, shown_columns, static_detector, units_of
+from align.calibration.jobs.common import (
+    detector_dict,
+    log_source,
+    read_sensor,
+    shown_columns,
+    static_detector,
+    with_remarks,
+)
 from align.calibration.results import CalibrationSet
 from align.io.logs import SensorLog
 from align.io.source import LogSource
@@ -32,7 +39,8 @@ class AccelOptions:
     ----------
     log : LogSource
         The accelerometer log (default columns ``acc_x, acc_y, acc_z`` or the old names, time ``time``;
-        unit m/s^2, ``"counts"`` or the size of one count ``"16384 LSB/g"``).
+        unit m/s^2, ``"counts"`` or the size of one count ``"16384 LSB/g"``; None: the unit the file states,
+        else m/s^2).
     positions : Path or None
         The positions file (TOML, ``[[position]]`` tables); None: orientations unknown, ``|a| = g`` fitted.
     gravity : float or None
@@ -95,20 +103,18 @@ def _accel_read(o: AccelOptions) -> AccelInputs:
     return AccelInputs(got, spec, shown_columns(time, data))
 
 
-
-
 def _accel_compute(i: AccelInputs, o: AccelOptions, progress: Progress | None) -> CalibrationSet:
     from align.calibration.accel import calibrate_accel_log
 
     got = i.acc
-    cal = calibrate_accel_log(got.t, got.data, i.spec, got.shown, o.gravity, static_detector(o), str(o.log.path),
-                              str(o.positions))
+    cal = with_remarks(calibrate_accel_log(got.t, got.data, i.spec, got.shown, o.gravity, static_detector(o),
+                                           str(o.log.path), str(o.positions)), (got, o.log))
     if progress is not None:
         progress(len(got.t))
     # how the log was read and the detector set: what the report needs to draw the session again
     return CalibrationSet({Sensor.ACCELEROMETER.value: cal}, {
         "log": str(o.log.path), "positions": None if o.positions is None else str(o.positions),
-        "accel_units": units_of(o.log, Sensor.ACCELEROMETER), "columns": i.columns, "rate_hz": o.log.rate_hz,
+        "accel_units": got.units, "columns": i.columns, "rate_hz": o.log.rate_hz,
         "detector": detector_dict(o), **got.inputs()})
 
 

@@ -1,9 +1,9 @@
 """What the calibration jobs share: a log given as a path with its source fields, one sensor's readings with
-its option named, the columns and units a result records, the static detector the options set.
+its option named, the columns, streams and reader notes a result records, the static detector the options set.
 
 Public names
 ------------
-SOURCE_FIELDS, log_source, read_sensor, shown_columns, same_file, accel_source, units_of, detector_dict,
+SOURCE_FIELDS, log_source, read_sensor, shown_columns, same_file, accel_source, accel_stream, with_remarks, detector_dict,
 static_detector
 """
 
@@ -19,8 +19,8 @@ from align.io.logs import SensorLog
 from align.io.source import LogSource, check_distinct
 from align.vocab import Sensor
 
-__all__ = ["SOURCE_FIELDS", "log_source", "read_sensor", "shown_columns", "same_file", "accel_source", "units_of",
-           "detector_dict", "static_detector"]
+__all__ = ["SOURCE_FIELDS", "log_source", "read_sensor", "shown_columns", "same_file", "accel_source", "accel_stream",
+           "with_remarks", "detector_dict", "static_detector"]
 
 #: the fields of a :class:`LogSource` a convenience call takes beside a log given as a path
 SOURCE_FIELDS = ("columns", "time_column", "rate_hz", "units", "format")
@@ -59,15 +59,26 @@ def accel_source(log: LogSource, accel: LogSource | None) -> LogSource:
     """The accelerometer's source: ``accel``, or its default columns in m/s^2 in ``log``'s file; in one file, no
     column named for both sensors (:func:`align.io.source.check_distinct`)."""
     acc = accel if accel is not None else LogSource(path=log.path, time_column=log.time_column, rate_hz=log.rate_hz,
-                                                    format=log.format)
+                                                    format=log.format)  # its unit: the file's, else m/s^2
     if same_file(log, acc) and (log.columns is not None or acc.columns is not None):
         check_distinct((Sensor.GYROSCOPE, log.data_names(Sensor.GYROSCOPE, "gyro_columns"), "gyro_columns"),
                        (Sensor.ACCELEROMETER, acc.data_names(Sensor.ACCELEROMETER, "accel_columns"), "accel_columns"))
     return acc
 
 
-def units_of(src: LogSource, sensor: Sensor) -> str:
-    return src.units or sensor.unit
+def accel_stream(acc: SensorLog, gyr: SensorLog) -> dict[str, Any]:
+    """What a result records of the accelerometer's stream beside the gyro's (:meth:`SensorLog.stream_inputs`):
+    ``accel_stream`` when it is another stream, ``accel_units_stated`` when the file states its unit."""
+    said = acc.stream_inputs("accel_")
+    if acc.source == gyr.source:
+        said.pop("accel_stream", None)
+    return said
+
+
+def with_remarks(cal: Any, *logs: tuple[SensorLog, LogSource]) -> Any:
+    """A calibration with its logs' reader notes (a truncated last record) added to its own, each after its file."""
+    extra = tuple(n for got, src in logs for n in got.remarks(str(src.path)))
+    return cal.replace(notes=tuple(cal.notes) + extra) if extra else cal
 
 
 def detector_dict(o: Any) -> dict[str, Any]:

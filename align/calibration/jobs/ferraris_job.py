@@ -15,7 +15,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from align.calibration.jobs.common import accel_source, log_source, read_sensor, same_file, units_of
+from align.calibration.jobs.common import accel_source, accel_stream, log_source, read_sensor, same_file, with_remarks
 from align.calibration.results import CalibrationSet
 from align.errors import InputError, literal
 from align.io.logs import SensorLog
@@ -35,11 +35,13 @@ class FerrarisOptions:
     ----------
     log : LogSource
         The session log, read at its sample rate (``rate_hz`` required, Hz); its ``columns`` and
-        ``units`` are the gyro's (default ``gyro_x, gyro_y, gyro_z`` or the old ``gyr_x, ...``; deg/s).
+        ``units`` are the gyro's (default ``gyro_x, gyro_y, gyro_z`` or the old ``gyr_x, ...``; the unit the
+        file states, else deg/s).
     sections : Path
         imucal's section list (JSON): ``x_p`` ... ``z_a``, ``x_rot``, ``y_rot``, ``z_rot``.
     accel : LogSource or None
-        The accelerometer's columns and unit (default: ``acc_x, acc_y, acc_z`` in m/s^2 in ``log``).
+        The accelerometer's columns and unit (default: ``acc_x, acc_y, acc_z`` in ``log``, in the unit the file
+        states, else m/s^2).
     turn_angle : float
         Signed angle of each turn about the axis pointing up, rad (imucal's -360 deg).
     gravity : float
@@ -107,11 +109,13 @@ def _ferraris_compute(i: FerrarisInputs, o: FerrarisOptions, progress: Progress 
     if progress is not None:
         progress(len(i.gyr.data))
     acc_src = accel_source(o.log, o.accel)
-    inputs = {"log": str(o.log.path), "sections": str(o.sections), "accel_units": units_of(acc_src, Sensor.ACCELEROMETER),
-              "gyro_units": units_of(o.log, Sensor.GYROSCOPE), **o.log.format.to_dict()}
+    inputs = {"log": str(o.log.path), "sections": str(o.sections), "accel_units": i.acc.units,
+              "gyro_units": i.gyr.units, **o.log.format.to_dict(), **i.gyr.stream_inputs()}
+    inputs.update(accel_stream(i.acc, i.gyr))
     if not same_file(o.log, acc_src):
         inputs["accel_log"] = str(acc_src.path)
-    return CalibrationSet({Sensor.ACCELEROMETER.value: acc_cal, Sensor.GYROSCOPE.value: gyr_cal}, inputs)
+    return CalibrationSet({Sensor.ACCELEROMETER.value: with_remarks(acc_cal, (i.acc, acc_src)),
+                           Sensor.GYROSCOPE.value: with_remarks(gyr_cal, (i.gyr, o.log))}, inputs)
 
 
 def _ferraris_files(o: FerrarisOptions) -> dict[str, Path | None]:

@@ -19,12 +19,13 @@ import numpy as np
 from align.calibration.accel import StaticDetector
 from align.calibration.jobs.common import (
     accel_source,
+    accel_stream,
     log_source,
     read_sensor,
     same_file,
     shown_columns,
     static_detector,
-    units_of,
+    with_remarks,
 )
 from align.calibration.results import CalibrationSet
 from align.errors import InputError
@@ -46,10 +47,11 @@ class GyroOptions:
     log : LogSource
         The session log: its time column (or ``rate_hz``, Hz), format, and the gyro's ``columns``
         (default ``gyro_x, gyro_y, gyro_z`` or the old ``gyr_x, ...``) and ``units`` (deg/s, ``"counts"``,
-        or the size of one count ``"131 LSB/(deg/s)"``).
+        or the size of one count ``"131 LSB/(deg/s)"``; None: the unit the file states, else deg/s).
     accel : LogSource or None
         The accelerometer: columns and unit in ``log``'s file, or a second file with the same time
-        stamps; None: ``acc_x, acc_y, acc_z`` (or the old names) in m/s^2 in ``log``.
+        stamps; None: ``acc_x, acc_y, acc_z`` (or the old names) in ``log``, in the unit the file states, else
+        m/s^2.
     gravity : float
         Local gravity, m/s^2.
     window_s : float
@@ -192,7 +194,8 @@ def _gyro_compute(i: GyroInputs, o: GyroOptions, progress: Progress | None) -> C
                                      [list(p) for p in o.intervals], o.gyro_range, o.drop_rotations, o.g_sensitivity,
                                      str(o.log.path), None if same_file(o.log, acc_src) else str(acc_src.path))
     i.session["session"] = session
-    acc_cal, gyr_cal = session.accelerometer, session.gyroscope
+    acc_cal, gyr_cal = with_remarks(session.accelerometer, (i.acc, acc_src)), with_remarks(session.gyroscope,
+                                                                                          (i.gyr, o.log))
     if o.frame is not None or o.mounting is not None:
         table, table_sigma = i.table if i.table is not None else (None, None)
         nominal = np.array(o.mounting, float) if o.mounting is not None else None
@@ -204,11 +207,11 @@ def _gyro_compute(i: GyroInputs, o: GyroOptions, progress: Progress | None) -> C
     intervals = o.intervals if not isinstance(o.intervals, tuple) else ",".join(f"{a}:{b}" for a, b in o.intervals)
     inputs = {"log": str(o.log.path), "accel_log": None if same_file(o.log, acc_src) else str(acc_src.path),
               "gyro_columns": i.gyro_columns, "accel_columns": i.accel_columns,
-              "accel_units": units_of(acc_src, Sensor.ACCELEROMETER), "gyro_units": units_of(o.log, Sensor.GYROSCOPE),
+              "accel_units": i.acc.units, "gyro_units": i.gyr.units,
               "intervals": intervals, "poses": [list(p) for p in session.poses],
               "dropped_rotations": list(o.drop_rotations), "g_sensitivity": o.g_sensitivity,
               "frame": None if o.frame is None else str(o.frame), "mounting": _mounting_text(o),
-              **i.gyr.inputs()}
+              **i.gyr.inputs(), **accel_stream(i.acc, i.gyr)}
     return CalibrationSet({Sensor.ACCELEROMETER.value: acc_cal, Sensor.GYROSCOPE.value: gyr_cal}, inputs)
 
 

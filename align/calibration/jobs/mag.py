@@ -11,13 +11,13 @@ MagOptions, MagInputs, MAG, calibrate_mag
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
 
-from align.calibration.jobs.common import log_source, units_of
+from align.calibration.jobs.common import log_source
 from align.calibration.magnetometer import MagCalibration
 from align.errors import InputError, literal
 from align.io.source import LogSource, column_names
@@ -52,7 +52,8 @@ class MagOptions:
     ----------
     log : LogSource
         The capture (default columns ``mag_x, mag_y, mag_z`` or the old ``mx, my, mz``; no time column
-        is read); unit uT, nT, gauss, mG, ``"counts"`` or the size of one count (``"0.92 mG"``).
+        is read); unit uT, nT, gauss, mG, ``"counts"`` or the size of one count (``"0.92 mG"``); None: the unit
+        the file states, else uT.
     accel_columns : tuple of str or None
         Simultaneous accelerometer columns in ``log`` (dip angle, alignment to gravity; any unit).
     field : float or None
@@ -99,6 +100,13 @@ class MagInputs:
         Factor from the file's numbers to T.
     columns : tuple of str
         The magnetometer columns read.
+    units : str
+        The unit the readings were read in (typed, stated by the file, or uT).
+    stream : dict
+        What the result records of the stream read (``stream``, ``units_stated``: as
+        :meth:`align.io.logs.SensorLog.stream_inputs`).
+    notes : tuple of str
+        The reader's remarks (a truncated last record), after the file's name.
     """
 
     m: np.ndarray
@@ -107,6 +115,9 @@ class MagInputs:
     captures: dict
     scale: float
     columns: tuple[str, ...]
+    units: str = Sensor.MAGNETOMETER.unit
+    stream: dict = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
 
 
 def _mag_columns(o: MagOptions) -> tuple[list[str], list[str]]:
@@ -129,17 +140,25 @@ def _mag_read(o: MagOptions) -> MagInputs:
     import align.io as fileio
     from align.calibration.axisdown import axis_down_captures
     from align.io.logs import check_readings
+    from align.io.readings import units_of
+    from align.io.tables import read_table
     from align.units import parse_scale
 
     if o.model not in ("sphere", "diagonal", "symmetric"):
         raise InputError(f"'{literal(str(o.model))}' is no soft-iron model; give sphere, diagonal or symmetric",
                          "{model}")
     fmt = o.log.format
-    scale, shown = parse_scale(units_of(o.log, Sensor.MAGNETOMETER), "magnetic_field", "{mag_units}")
+    if o.log.units is not None:  # a typed unit is checked before the file is read
+        parse_scale(o.log.units, "magnetic_field", "{mag_units}")
     mag, acc = _mag_columns(o)
     wanted = mag + acc
-    _, data = fileio.read_columns(o.log.path, wanted, log_format=fmt)
+    got = read_table(o.log.path, wanted, None, fmt)
+    data = got.data
+    unit, stated = units_of(o.log.units, got.unit(mag), Sensor.MAGNETOMETER.unit, "magnetic_field", "mag_units",
+                            str(o.log.path))
+    scale, shown = parse_scale(unit, "magnetic_field", "{mag_units}")
     check_readings(data, str(o.log.path))
+    stream = {**({"stream": dict(got.source)} if got.source else {}), **({"units_stated": unit} if stated else {})}
 
     def read(path: str) -> np.ndarray:  # an axis-down capture file: the log's columns, checked as the log is
         got = fileio.read_columns(path, wanted, log_format=fmt)[1]
@@ -153,7 +172,8 @@ def _mag_read(o: MagOptions) -> MagInputs:
         captures, tumble = axis_down_captures(spec, data, str(o.log.path), read)
     if o.field is not None and not o.field > 0:
         raise InputError("give a field strength > 0, e.g. '48.5 uT'", "{field}")
-    return MagInputs(tumble[:, :3] * scale, tumble[:, 3:6] if acc else None, shown, captures, scale, tuple(mag))
+    return MagInputs(tumble[:, :3] * scale, tumble[:, 3:6] if acc else None, shown, captures, scale, tuple(mag), unit,
+                     stream, tuple(f"{o.log.path}: {n}" for n in got.notes))
 
 
 def _mag_compute(i: MagInputs, o: MagOptions, progress: Progress | None) -> MagCalibration:
@@ -169,9 +189,10 @@ def _mag_compute(i: MagInputs, o: MagOptions, progress: Progress | None) -> MagC
         cal = with_gravity_alignment(cal, i.m, i.acc)
     if progress is not None:
         progress(len(i.m))
-    return cal.replace(inputs={"log": str(o.log.path), "columns": ",".join(i.columns),
-                               "mag_units": units_of(o.log, Sensor.MAGNETOMETER), **o.log.format.to_dict(),
-                               **({"axis_down": _axis_down_text(o.axis_down)} if o.axis_down is not None else {})})
+    return cal.replace(inputs={"log": str(o.log.path), "columns": ",".join(i.columns), "mag_units": i.units,
+                               **o.log.format.to_dict(),
+                               **({"axis_down": _axis_down_text(o.axis_down)} if o.axis_down is not None else {}),
+                               **i.stream}, notes=tuple(cal.notes) + i.notes)
 
 
 def _mag_files(o: MagOptions) -> dict[str, Path | None]:
