@@ -52,6 +52,7 @@ KNOWN: dict[str, str] = {
     "imu-align.check": "align.sensitivity.margins",
     "imu-align.budget": "mechanics.budget",
     "imu-align.drift": "align.navigation.result",
+    "imu-align.thermal": "align.calibration.thermal.result",
 }
 
 _TYPES: dict[str, type[Result]] = {}

@@ -17,8 +17,10 @@ from support import ROOT
 #: modules whose docstring examples are the API reference's (docs/*.rst automodule them, or the package they are in)
 MODULES = [
     "align.vocab",
-    "align.io.source", "align.io.inspect", "align.io.noise_consumers", "align.io.dataflash", "align.io.dataflash_format",
-    "align.noise.periodic",
+    "align.io.source", "align.inspection", "align.io.noise_consumers", "align.io.dataflash", "align.io.dataflash_format",
+    "align.noise.periodic", "align.calibration.thermal.job", "align.calibration.thermal.model",
+    "align.calibration.thermal.fit", "align.calibration.thermal.branches", "align.calibration.thermal.checks",
+    "align.calibration.thermal.firmware", "align.calibration.thermal.simulate", "align.calibration.thermal.result",
     "align.job",
     "align.provenance",
     "align.results",

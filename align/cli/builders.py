@@ -34,6 +34,7 @@ BUILDERS: dict[str, tuple[str, str | None]] = {
     "calibrate accel": ("align.cli.calibrate_accel:accel_options", "align.cli.calibrate_accel:accel_files"),
     "calibrate mag": ("align.cli.calibrate_mag:mag_options", "align.cli.calibrate_mag:mag_files"),
     "calibrate gyro": ("align.cli.calibrate_gyro:gyro_options", "align.cli.calibrate_gyro:gyro_files"),
+    "calibrate thermal": ("align.cli.calibrate_thermal:thermal_options", "align.cli.calibrate_thermal:thermal_files"),
     "budget": ("align.cli.budget:budget_options", "align.cli.budget:budget_files"),
     "allowable": ("align.cli.allowable:allowable_options", None),
     "check": ("align.cli.check:check_options", None),

@@ -16,13 +16,15 @@ from align.cli.calibrate_accel import accel
 from align.cli.calibrate_ferraris import ferraris
 from align.cli.calibrate_gyro import gyro
 from align.cli.calibrate_mag import mag
+from align.cli.calibrate_thermal import thermal
 
-__all__ = ["app", "ferraris", "accel", "mag", "gyro", "COMMANDS"]
+__all__ = ["app", "ferraris", "accel", "mag", "gyro", "thermal", "COMMANDS"]
 
-COMMANDS: dict[str, Callable[..., Any]] = {"ferraris": ferraris, "accel": accel, "mag": mag, "gyro": gyro}
+COMMANDS: dict[str, Callable[..., Any]] = {"ferraris": ferraris, "accel": accel, "mag": mag, "gyro": gyro,
+                                           "thermal": thermal}
 
 app = typer.Typer(help="Sensor calibration: Ferraris sessions, accelerometer positions, magnetometer ellipsoid, gyro "
-                       "without a rate table.",
+                       "without a rate table, bias against temperature.",
                   add_completion=False, rich_markup_mode=None, pretty_exceptions_enable=False)
 for _name, _command in COMMANDS.items():
     app.command(_name)(_command)

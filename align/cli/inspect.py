@@ -1,4 +1,4 @@
-"""``imu-align inspect``: what a log holds before any job (:func:`align.io.inspect.inspect_log`).
+"""``imu-align inspect``: what a log holds before any job (:func:`align.inspection.inspect_log`).
 
 Public names
 ------------
@@ -32,7 +32,7 @@ def inspect_log_command(
     its samples, rates, duration, gaps and dropped samples, time out of order, temperature range, clipped samples
     and the units it states."""
     check_outputs([log], json_out=json_out)
-    from align.io.inspect import inspect_log
+    from align.inspection import inspect_log
 
     found = inspect_log(log, opt.log_format(skip_rows=skip_rows, comment=comment, delimiter=delimiter,
                                             time_units=time_units, topic=topic, stamps=stamps), time_column)

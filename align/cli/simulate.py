@@ -280,8 +280,41 @@ def lot(
                                 rate_hz, noise)
 
 
+def thermal(
+    out_dir: opt.Arg("Folder for thermal.csv and truth.json (created if missing).", "OUT_DIR"),
+    rate_hz: opt.RateHz("Sample rate.") = "20 Hz",
+    low: opt.Number("--low", "Lowest chamber temperature, C.", opt.ANY, "-10", "DEGC") = -10.0,
+    high: opt.Number("--high", "Highest chamber temperature, C.", opt.ANY, "60", "DEGC") = 60.0,
+    ramp: opt.Number("--ramp", "Heating rate, C/min.", POSITIVE, "4", "C_PER_MIN") = 4.0,
+    ramp_down: opt.Number("--ramp-down", "Cooling rate, C/min.", POSITIVE, "6", "C_PER_MIN") = 6.0,
+    soak: opt.Quantity("--soak", "time", "Soak at each end.", "TIME", PAUSE, "'60 s'") = "60 s",
+    cycles: opt.Number("--cycles", "Up and down cycles (1.5: up, down, up).", POSITIVE, "1.5", "N") = 1.5,
+    resolution: opt.Number("--resolution", "Step of the temperature reading, C (0: continuous).", NONNEGATIVE,
+                           "1", "DEGC") = 0.0,
+    seed: opt.Seed = 0,
+    force: Force = False,
+) -> None:
+    """Simulate a static IMU in a thermal chamber with known bias cubic, lag and hysteresis (for calibrate thermal):
+    thermal.csv (time, gyro deg/s, accel m/s^2, temperature C) and truth.json."""
+    names = ("thermal.csv", "truth.json")
+    check_outputs([], folder=("out_dir", out_dir, names))
+    refuse_replacing("out_dir", out_dir, names, force)
+    from align.calibration.thermal.simulate import Profile, chamber_log
+    from align.errors import InputError
+
+    if not high > low:
+        raise InputError("give a highest temperature above the lowest", "{high}")
+    columns, table, truth = chamber_log(Profile(low, high, ramp / 60, ramp_down / 60, soak, cycles), rate_hz, seed,
+                                        resolution)
+    with outputs() as out:
+        out.folder(out_dir)
+        out.write_csv(out_dir / names[0], columns, table)
+        out.write_json(out_dir / names[1], truth)
+    typer.echo(f"wrote {out_dir}/thermal.csv ({len(table)} rows, {table[-1, 0]:.0f} s) and truth.json")
+
+
 #: ``simulate``'s subcommands
-COMMANDS = {"session": session, "poses": poses, "lot": lot}
+COMMANDS = {"session": session, "poses": poses, "lot": lot, "thermal": thermal}
 SUBCOMMANDS = tuple(COMMANDS)
 
 app = typer.Typer(help="Simulated inputs with known truth, for rehearsals: a rate-table session, a multi-position "

@@ -54,7 +54,7 @@ def test_one_spelling_per_concept():
     """No command offers a retired spelling; units, columns and the sample rate are spelled one way."""
     retired = {"--gyr-units", "--acc-units", "--allan-units", "--gyr-columns", "--acc-columns", "--allan-columns",
                "--allan-rate-hz", "--fs"}
-    units = {"--gyro-units", "--accel-units", "--mag-units", "--units", "--time-units"}
+    units = {"--gyro-units", "--accel-units", "--mag-units", "--units", "--time-units", "--temperature-units"}
     for path in PATHS:
         opts = {o for p in _params(path).params for o in getattr(p, "opts", []) if o.startswith("--")}
         assert not opts & retired, (path, opts & retired)

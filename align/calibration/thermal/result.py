@@ -1,0 +1,177 @@
+"""The thermal calibration file: the registered result ``imu-align.thermal``.
+
+One key per sensor calibrated (``gyroscope``, ``accelerometer``), each with its reference temperature and valid
+range, and per axis the model (coefficients about the reference, the lag coefficient, their covariance) and what
+its fit found (order and cross-validation table, residual before and after, band, hysteresis, held-out branch
+check). Readings in the file's unit (``units``), temperatures in degrees Celsius.
+
+Public names
+------------
+ThermalCalibration, FORMAT, CONVENTION, BAND, HYSTERESIS
+"""
+
+from __future__ import annotations
+
+from dataclasses import field
+from typing import Any
+
+import numpy as np
+
+from align.calibration.thermal.branches import Hysteresis
+from align.calibration.thermal.model import AxisModel, ThermalModel
+from align.calibration.thermal.sensor import AxisReport, SensorThermal
+from align.errors import InputError
+from align.io.keys import check_keys
+from align.results import Result
+from align.units import parse_unit
+from align.wellformed import malformed
+
+__all__ = ["ThermalCalibration", "FORMAT", "CONVENTION", "BAND", "HYSTERESIS"]
+
+FORMAT = "imu-align.thermal"
+CONVENTION = ("bias(T, dT/dt) = sum_k c_k d^k + lag dT/dt, d = clip(T, tmin, tmax) - tref; compensated = raw - bias; "
+              "T in degC; the firmware files carry the static curve (dT/dt = 0)")
+#: how the band is made (written in the file)
+BAND = ("1 sigma of the static curve: s^2 (X^T X)^-1 times the residuals' integrated autocorrelation time (blocking "
+        "method over contiguous blocks); inflation = sqrt of that time")
+#: what the hysteresis is (written in the file)
+HYSTERESIS = ("heating minus cooling at equal temperature where largest in size over the range both branches cover, "
+              "each branch fitted alone with the axis' order and no lag term (so it includes what a lag term "
+              "explains); sigma at that temperature")
+SENSORS = ("gyroscope", "accelerometer")
+_SENSOR_KEYS = ("units", "reference_temperature", "valid_range", "samples", "temperature_resolution", "branches",
+                "notes", "axes")
+_AXIS_KEYS = ("axis", "order", "lag", "coefficients", "lag_coefficient", "covariance", "cross_validation", "residual",
+              "band", "hysteresis", "branch_check")
+
+
+def _axis_dict(model: AxisModel, rep: AxisReport, name: str, f: float) -> dict[str, Any]:
+    h = rep.hysteresis
+    return {
+        "axis": name, "order": rep.order, "lag": rep.lag,
+        "coefficients": (model.coefficients / f).tolist(),
+        "lag_coefficient": None if model.lag is None else model.lag / f,
+        "covariance": (model.covariance / (f * f)).tolist(),
+        "cross_validation": [{"order": k, "lag": g, "rms": r / f} for k, g, r in rep.cv],
+        "residual": {"before": {"rms": rep.rms_before / f, "largest": rep.max_before / f},
+                     "after": {"rms": rep.rms_after / f, "largest": rep.max_after / f},
+                     "one_cubic_rms": rep.rms_cubic / f},
+        "band": {"largest_1sigma": rep.band_max / f, "inflation": rep.inflation},
+        "hysteresis": None if h is None else {"value": h.value / f, "sigma": h.sigma / f, "at": h.at,
+                                              "overlap": [h.lo, h.hi]},
+        "branch_check": None if rep.crosscheck is None else {"heating_to_cooling_rms": rep.crosscheck[0] / f,
+                                                             "cooling_to_heating_rms": rep.crosscheck[1] / f},
+    }
+
+
+def _axis_from(d: dict, f: float, where: str) -> tuple[AxisModel, AxisReport]:
+    check_keys(d, _AXIS_KEYS, where)
+    coef = np.array(d["coefficients"], float) * f
+    lag = None if d["lag_coefficient"] is None else float(d["lag_coefficient"]) * f
+    cov = np.array(d["covariance"], float) * f * f
+    res, band, h, b = d["residual"], d["band"], d["hysteresis"], d["branch_check"]
+    hyst = None if h is None else Hysteresis(float(h["value"]) * f, float(h["sigma"]) * f, float(h["at"]),
+                                             float(h["overlap"][0]), float(h["overlap"][1]))
+    cross = None if b is None else (float(b["heating_to_cooling_rms"]) * f, float(b["cooling_to_heating_rms"]) * f)
+    rep = AxisReport(int(d["order"]), bool(d["lag"]),
+                     tuple((int(r["order"]), bool(r["lag"]), float(r["rms"]) * f) for r in d["cross_validation"]),
+                     float(res["before"]["rms"]) * f, float(res["before"]["largest"]) * f,
+                     float(res["after"]["rms"]) * f, float(res["after"]["largest"]) * f,
+                     float(res["one_cubic_rms"]) * f, float(band["largest_1sigma"]) * f, float(band["inflation"]),
+                     hyst, cross)
+    if len(coef) != rep.order + 1 or not np.all(np.isfinite(coef)):
+        raise ValueError(f"{len(coef)} finite coefficients expected for order {rep.order}")
+    return AxisModel(coef, lag, cov), rep
+
+
+class ThermalCalibration(Result, format=FORMAT, convention=CONVENTION):
+    """The thermal calibration of a log's sensors (module docstring).
+
+    Attributes
+    ----------
+    sensors : dict of str -> SensorThermal
+        Keys among ``gyroscope``, ``accelerometer``.
+    inputs : dict
+        The log and settings it came from.
+
+    Examples
+    --------
+    >>> from align.calibration.thermal.simulate import Profile, random_truth, simulate
+    >>> from align.calibration.thermal.sensor import Settings, fit_sensor
+    >>> prof = Profile(-10.0, 50.0, 5 / 60, 5 / 60, 0.0, 1.0)
+    >>> rng = np.random.default_rng(1)
+    >>> run = simulate(prof, random_truth(rng, prof, 0.01), 2.0, 0.002, rng)
+    >>> s = fit_sensor(run.t, run.temperature, run.data, "accelerometer", "m/s^2", 2.0, Settings(), "sim")
+    >>> r = ThermalCalibration({"accelerometer": s})
+    >>> back = ThermalCalibration.from_dict(r.to_dict())
+    >>> bool(np.allclose(back.model("accelerometer").axes[0].coefficients, s.model.axes[0].coefficients))
+    True
+    """
+
+    sensors: dict
+    inputs: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        unknown = [k for k in self.sensors if k not in SENSORS]
+        if unknown or not self.sensors:
+            raise ValueError(f"a thermal calibration holds {' and/or '.join(SENSORS)}, not {unknown or 'nothing'}")
+        object.__setattr__(self, "sensors", {k: self.sensors[k] for k in SENSORS if k in self.sensors})
+        object.__setattr__(self, "inputs", dict(self.inputs))
+
+    def model(self, sensor: str | None = None, where: str = "thermal calibration") -> ThermalModel:
+        """The model of ``sensor`` (the only one when None)."""
+        if sensor is None and len(self.sensors) == 1:
+            return next(iter(self.sensors.values())).model
+        if sensor not in self.sensors:
+            raise InputError(f"holds {', '.join(self.sensors)}; choose one with {{sensor}}", where)
+        return self.sensors[sensor].model
+
+    def to_dict(self) -> dict[str, Any]:
+        """The versioned JSON form: the envelope, ``inputs``, ``band``, then one key per sensor."""
+        out = {**self.envelope({**{k: s.units for k, s in self.sensors.items()}, "temperature": "degC"}),
+               "inputs": self.inputs, "band": BAND, "hysteresis": HYSTERESIS}
+        for key, s in self.sensors.items():
+            f = parse_unit(s.units).factor
+            m = s.model
+            out[key] = {
+                "units": {"readings": s.units, "coefficients": f"{s.units} per degC^k",
+                          "lag": f"{s.units} per degC/s"},
+                "reference_temperature": m.tref, "valid_range": [m.tmin, m.tmax], "samples": s.samples,
+                "temperature_resolution": s.resolution, "branches": dict(s.branches), "notes": list(s.notes),
+                "axes": [_axis_dict(ax, rep, "xyz"[i], f) for i, (ax, rep) in enumerate(zip(m.axes, s.axes))],
+            }
+        return out
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "thermal calibration") -> ThermalCalibration:
+        """Read the form written by :meth:`to_dict`."""
+        cls.check_envelope(d, where, keys=["inputs", "band", "hysteresis", *SENSORS])
+        sensors = {}
+        for key in SENSORS:
+            if key not in d:
+                continue
+            at = f"{where}: {key}"
+            try:
+                s = d[key]
+                check_keys(s, _SENSOR_KEYS, at)
+                units = s["units"]["readings"]
+                f = parse_unit(units, None, f"{at}: units").factor
+                pairs = [_axis_from(a, f, f"{at}: axis {i}") for i, a in enumerate(s["axes"])]
+                if len(pairs) != 3:
+                    raise ValueError("three axes expected")
+                lo, hi = (float(v) for v in s["valid_range"])
+                model = ThermalModel(key, float(s["reference_temperature"]), lo, hi, tuple(p[0] for p in pairs))
+                sensors[key] = SensorThermal(model, units, tuple(p[1] for p in pairs), dict(s.get("branches") or {}),
+                                             float(s["temperature_resolution"]), int(s["samples"]),
+                                             tuple(s.get("notes") or ()))
+            except InputError:
+                raise
+            except (KeyError, TypeError, ValueError, IndexError) as exc:
+                raise InputError(f"malformed thermal calibration ({malformed(exc)}); regenerate it", at) from None
+        if not sensors:
+            raise InputError(f"holds no {' or '.join(SENSORS)} thermal calibration", where)
+        inputs = d.get("inputs") or {}
+        if not isinstance(inputs, dict):
+            raise InputError("inputs must be an object", f"{where}: inputs")
+        return cls(sensors, inputs)
