@@ -14,9 +14,14 @@ A job is two steps, so that a caller that also draws the readings (``--plot``) r
 ``read(options) -> inputs`` (files -> checked inputs, a job's own frozen type) and
 ``compute(inputs, options, progress) -> result``. ``run`` is the two in turn.
 
+Every options value is checked before a job reads anything (:func:`check_options`): a field typed as a
+number takes a finite number (a quantity string such as ``"2 s"`` where the field states its unit with
+:func:`quantity`), within the domain the field states; a flag takes True or False; a whole number a whole
+number. One :class:`~align.errors.InputError` names the field (``{min_dwell}``) and what to give.
+
 Public names
 ------------
-Job, Progress, fields_signature
+Job, Progress, fields_signature, check_options, quantity
 """
 
 from __future__ import annotations
@@ -29,7 +34,7 @@ from typing import Any, Generic, TypeVar
 from align.provenance import Provenance, start_hashing
 from align.results import Result
 
-__all__ = ["Job", "Progress", "fields_signature"]
+__all__ = ["Job", "Progress", "fields_signature", "check_options", "quantity"]
 
 #: ``progress(n)``: n more units of work done (samples read, runs made); the library never draws it
 Progress = Callable[[int], None]
@@ -93,6 +98,7 @@ class Job(Generic[O, I, R]):
     def run_with_inputs(self, options: O, *, progress: Progress | None = None) -> tuple[R, I]:
         """As :meth:`run`, and the checked inputs too (for a caller that also draws them). The input files'
         SHA-256 is computed in the background while the job computes (:func:`align.provenance.start_hashing`)."""
+        options = check_options(options)
         inputs = self.read(options)
         start_hashing([p for p in self.files(options).values() if p is not None])
         return self.stamp(self.compute(inputs, options, progress), options), inputs
@@ -134,3 +140,90 @@ def fields_signature(options: type) -> Callable[[F], F]:
 
     return decorate
 
+
+
+#: the SI unit a dimension's quantity is held in, for messages
+SI_UNITS = {"angle": "rad", "angular_rate": "rad/s", "length": "m", "time": "s", "frequency": "Hz",
+            "acceleration": "m/s^2", "dimensionless": ""}
+
+
+def quantity(default: Any, dimension: str, *, gt: float | None = None, ge: float | None = None,
+             lt: float | None = None, le: float | None = None) -> Any:
+    """An options field holding a quantity in SI: its ``dimension`` (a key of :data:`align.units.DIMENSIONS`:
+    ``"time"``, ``"angular_rate"``, ``"dimensionless"``) and its domain in SI, read by :func:`check_options` (a
+    string such as ``"2 s"`` is parsed into it).
+
+    Examples
+    --------
+    >>> from dataclasses import dataclass
+    >>> @dataclass(frozen=True, kw_only=True)
+    ... class Opts:
+    ...     dwell: float = quantity(1.0, "time", gt=0)
+    >>> check_options(Opts(dwell="1500 ms")).dwell
+    1.5
+    """
+    import dataclasses
+
+    return dataclasses.field(default=default, metadata={"dimension": dimension, "gt": gt, "ge": ge, "lt": lt,
+                                                        "le": le})
+
+
+def _kinds(hint: Any) -> set[Any]:
+    import typing
+
+    args = typing.get_args(hint)
+    return set(args) if typing.get_origin(hint) in (typing.Union, getattr(__import__("types"), "UnionType", None)) \
+        else {hint}
+
+
+def check_options(options: Any) -> Any:
+    """``options`` checked field by field (module docstring); quantity strings parsed into SI.
+
+    Returns
+    -------
+    The same options, or a copy with the parsed quantities.
+
+    Raises
+    ------
+    InputError
+        Naming the field (``{name}``) and what to give.
+    """
+    import dataclasses
+    import math
+    import numbers
+    import typing
+
+    from align.errors import InputError
+    from align.units import parse_quantity
+
+    cls = type(options)  # resolved where it was defined (a package may show it as its own: cls.__module__)
+    hints = typing.get_type_hints(cls, globalns=getattr(cls.__init__, "__globals__", None))
+    parsed: dict[str, Any] = {}
+    for f in dataclasses.fields(options):
+        value, kinds, meta, where = getattr(options, f.name), _kinds(hints.get(f.name)), f.metadata, "{" + f.name + "}"
+        if value is None and type(None) in kinds:
+            continue
+        dim = meta.get("dimension")
+        unit = SI_UNITS.get(dim, dim) if dim else None
+        if float in kinds and isinstance(value, str) and dim is not None:
+            value = parsed[f.name] = parse_quantity(value, dim, where)
+        if float in kinds and not isinstance(value, str):
+            if isinstance(value, bool) or not isinstance(value, numbers.Real):
+                raise InputError(f"{value!r} is not a number; give one" + (f" in {unit}" if unit else ""), where)
+            if not math.isfinite(value):
+                raise InputError(f"{value!r} is not a finite number; give one" + (f" in {unit}" if unit else ""),
+                                 where)
+            for key, ok, word in (("gt", lambda v, b: v > b, ">"), ("ge", lambda v, b: v >= b, ">="),
+                                  ("lt", lambda v, b: v < b, "<"), ("le", lambda v, b: v <= b, "<=")):
+                bound = meta.get(key)
+                if bound is not None and not ok(value, bound):
+                    raise InputError(f"{value:g} is out of range; give a value {word} {bound:g}"
+                                     + (f" ({unit})" if unit else ""), where)
+        elif float in kinds and isinstance(value, str):
+            raise InputError(f"'{value}' is not a number; give a number" + (f" in {unit}" if unit else ""), where)
+        elif bool in kinds and float not in kinds and not isinstance(value, bool):
+            raise InputError(f"{value!r} is not True or False", where)
+        elif int in kinds and float not in kinds and bool not in kinds and (
+                isinstance(value, bool) or not isinstance(value, numbers.Integral)):
+            raise InputError(f"{value!r} is not a whole number; give one", where)
+    return dataclasses.replace(options, **parsed) if parsed else options

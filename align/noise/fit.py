@@ -40,11 +40,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from align.errors import TestError
+from align.noise import periodic
 from align.noise.allan import AllanResult, confidence_interval, edf_overlapping, tau_grid
 from align.noise.covariance import avar_covariance, avar_covariance_basis
 from align.noise.gls import FALSE_ALARM, GlsFit, nnls_small, scaled_nnls, whitener
 from align.noise.model import NOISE_ALPHA, TERMS, NoiseModel, avar_design, model_adev
-from align.noise import periodic
 from align.noise.readouts import point_readouts
 from align.values import Value
 
@@ -55,6 +55,8 @@ FIT_METHOD = ("generalised least squares on the overlapping Allan variance with 
               "model (IEEE 952 five-term model, non-negative squared terms)")
 #: most curve points the fit uses (log-spaced, the longest tau always among them)
 FIT_POINTS = 32
+#: least EDF of a point a deterministic signal (ramp, periodic disturbance) is tested on
+SIGNAL_EDF = 10.0
 #: refits with the covariance of the previous fit
 ITERATIONS = 3
 #: one-sided level of each point's bound behind them (the minimum over several points: about 95 % overall)
@@ -195,7 +197,11 @@ def fit_noise(res: AllanResult, channel: int, min_edf: float = 2.0, where: str |
     a, y = avar_design(tau[pick]), avar[pick]
     basis = avar_covariance_basis(res.m[pick], res.n_phase, res.fs, ramp=True) / res.runs
     fallback = 2 * np.maximum(a @ p, y) ** 2 / np.maximum(edf[pick], 1.0)
-    gls = GlsFit(a, y, basis, fallback)
+    # where a deterministic signal is tested (GlsFit._signal_fit): the points' EDF, and not more than the start
+    # model's dominant term gives them (the per-tau identification can read a long-tau point as white, EDF 100+)
+    alpha = np.array([NOISE_ALPHA[d] for d in dominant])[pick]
+    strong = np.minimum(edf[pick], edf_overlapping(res.n_phase, res.m[pick], alpha) * max(int(res.runs), 1)) >= SIGNAL_EDF
+    gls = GlsFit(a, y, basis, fallback, signal_points=strong)
     period, periodic_note = float("nan"), []
     if len(pick) > 7:  # a sixth column: the period whose signature best fits what the terms leave (align.noise.periodic)
         q = gls._iterate(p, ITERATIONS)
@@ -203,7 +209,7 @@ def fit_noise(res: AllanResult, channel: int, min_edf: float = 2.0, where: str |
         period, _, count = periodic.scan(tau[pick], wh @ (y - a @ q), wh)
         if np.isfinite(period):
             a6 = np.column_stack([a, periodic.signature(tau[pick], period)])
-            gls = GlsFit(a6, y, basis, fallback, scan=np.r_[np.ones(5), count])
+            gls = GlsFit(a6, y, basis, fallback, scan=np.r_[np.ones(5), count], signal_points=strong)
             p = np.r_[q, 0.0]
     p, cov, _ = gls.solve(p, ITERATIONS)
     wave = np.array([period, np.sqrt(p[5])]) if len(p) > 5 and gls.claimed[5] else np.full(2, np.nan)

@@ -22,7 +22,7 @@ from align.alignment.segment import Segment, SegmentOptions
 from align.errors import InputError, literal
 from align.io.logs import SensorLog
 from align.io.source import LogSource
-from align.job import Job, Progress, fields_signature
+from align.job import Job, Progress, fields_signature, quantity
 from align.units import DEG, DEG_S
 from align.vocab import Sensor
 
@@ -79,15 +79,15 @@ class MatrixOptions:
     method: str = "auto"
     two_axis_variant: str = "procrustes"
     segments: Path | None = None
-    gyro_range: float | None = None
-    min_dwell: float = 1.0
-    window: float = 0.1
-    margin: float = 0.1
-    static_threshold: float = 1.0 * DEG_S
-    rate_tolerance: float = 0.10
-    scale_tolerance: float = 0.05
-    axis_to_axis: float = 0.05 * DEG
-    scale_spec: float = 0.01
+    gyro_range: float | None = quantity(None, "angular_rate", gt=0)
+    min_dwell: float = quantity(1.0, "time", gt=0, le=86400)
+    window: float = quantity(0.1, "time", gt=0, le=86400)
+    margin: float = quantity(0.1, "time", ge=0, le=86400)
+    static_threshold: float = quantity(1.0 * DEG_S, "angular_rate", gt=0)
+    rate_tolerance: float = quantity(0.10, "dimensionless", gt=0, le=1)
+    scale_tolerance: float = quantity(0.05, "dimensionless", gt=0, le=1)
+    axis_to_axis: float = quantity(0.05 * DEG, "angle", gt=0)
+    scale_spec: float = quantity(0.01, "dimensionless", gt=0, le=1)
     earth: bool = True
 
     def __post_init__(self) -> None:
