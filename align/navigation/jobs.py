@@ -17,6 +17,7 @@ DriftOptions, DriftInputs, DRIFT, drift, LEVEL_TIME, MAX_RUNS
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,7 +27,7 @@ import numpy as np
 
 from align.errors import InputError
 from align.io.source import LogSource, check_distinct
-from align.job import Job, Progress, fields_signature
+from align.job import Job, Progress, fields_signature, quantity
 from align.navigation.mission import Mission
 from align.navigation.residuals import MOUNT_ERRORS, ResidualErrors
 from align.navigation.result import DriftResult
@@ -98,7 +99,7 @@ class DriftOptions:
         Random seed of the Monte Carlo.
     """
 
-    duration: float | None = None
+    duration: float | None = quantity(None, "time", gt=0)
     allan: tuple[Path, ...] = ()
     alignment: Path | None = None
     budget: Path | None = None
@@ -111,11 +112,11 @@ class DriftOptions:
     accel_columns: tuple[str, ...] | None = None
     accel_units: str | None = None
     runs: int = 1000
-    rate_hz: float = 100.0
-    nav_rate: float | None = None
+    rate_hz: float = quantity(100.0, "frequency", gt=0)
+    nav_rate: float | None = quantity(None, "frequency", gt=0)
     turn_rate: float = 10 * DEG
     heading: float = 0.0
-    latitude: float = 45 * DEG
+    latitude: float = quantity(45 * DEG, "angle", ge=-math.pi / 2, le=math.pi / 2)
     earth_rate: bool = False
     gyro_bias: float | None = None
     accel_bias: float | None = None

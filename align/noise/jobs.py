@@ -23,7 +23,7 @@ from typing import Any
 from align.errors import InputError
 from align.io.formats import LogFormat
 from align.io.source import LogSource
-from align.job import Job, Progress, fields_signature
+from align.job import Job, Progress, fields_signature, quantity
 from align.noise.analysis import AllanAnalysis, plan_from_allan, run_allan
 from align.noise.planner import PlanResult, make_plan, model_curve, preset_model
 from align.noise.records import MOTION_ACCELERATION, MOTION_RATE, AllanInputs, allan_columns, allan_unit, read_records
@@ -80,17 +80,17 @@ class AllanOptions:
     logs: tuple[Path, ...]
     columns: tuple[str, ...] | None = None
     time_column: str | None = None
-    rate_hz: float | None = None
+    rate_hz: float | None = quantity(None, "frequency", gt=0)
     gyro_units: str | None = None
     units: str | None = None
     format: LogFormat = field(default_factory=LogFormat)
     grid: str | tuple[float, ...] = "dense"
     per_decade: int = 10
     modified: bool = False
-    rate: float | None = None
-    accuracy: float | None = None
-    noise_ratio: float = 10.0
-    memory_limit: float = 2e9
+    rate: float | None = quantity(None, "angular_rate", gt=0)
+    accuracy: float | None = quantity(None, "angle", gt=0, le=math.pi / 2)
+    noise_ratio: float = quantity(10.0, "dimensionless", gt=0)
+    memory_limit: float = quantity(2e9, "dimensionless", gt=0)
     periods: tuple[float, ...] = (1.0, 10.0)
 
     def __post_init__(self) -> None:
@@ -252,15 +252,15 @@ class PlanOptions:
 
     rate: float
     accuracy: float
-    noise_ratio: float = 10.0
-    arw: float | None = None
-    bias_instability: float | None = None
-    rate_random_walk: float | None = None
+    noise_ratio: float = quantity(10.0, "dimensionless", gt=0)
+    arw: float | None = quantity(None, "angle_random_walk", ge=0)
+    bias_instability: float | None = quantity(None, "angular_rate", ge=0)
+    rate_random_walk: float | None = quantity(None, "rate_random_walk", ge=0)
     imu: str | None = None
     allan: Path | None = None
     parts: Path | None = None
-    turn_angle: float = 2 * math.pi
-    settle: float = 2.0
+    turn_angle: float = quantity(2 * math.pi, "angle", gt=0)
+    settle: float = quantity(2.0, "time", ge=0)
     steps: int = 6
 
     def __post_init__(self) -> None:

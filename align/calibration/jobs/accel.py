@@ -25,7 +25,7 @@ from align.calibration.jobs.common import (
 from align.calibration.results import CalibrationSet
 from align.io.logs import SensorLog
 from align.io.source import LogSource
-from align.job import Job, Progress, fields_signature
+from align.job import Job, Progress, fields_signature, quantity
 from align.vocab import Sensor
 
 __all__ = ["AccelOptions", "AccelInputs", "ACCEL", "calibrate_accel"]
@@ -57,11 +57,11 @@ class AccelOptions:
 
     log: LogSource
     positions: Path | None = None
-    gravity: float | None = None
-    window_s: float = 1.0
-    factor: float = 6.0
-    init_static_s: float | None = None
-    min_static_s: float = 1.0
+    gravity: float | None = quantity(None, "acceleration", gt=0)
+    window_s: float = quantity(1.0, "time", gt=0)
+    factor: float = quantity(6.0, "dimensionless", gt=0)
+    init_static_s: float | None = quantity(None, "time", gt=0)
+    min_static_s: float = quantity(1.0, "time", gt=0)
 
     @property
     def detector(self) -> StaticDetector:

@@ -20,7 +20,7 @@ from align.calibration.results import CalibrationSet
 from align.errors import InputError, literal
 from align.io.logs import SensorLog
 from align.io.source import LogSource
-from align.job import Job, Progress, fields_signature
+from align.job import Job, Progress, fields_signature, quantity
 from align.units import STANDARD_GRAVITY
 from align.vocab import Sensor
 
@@ -56,7 +56,7 @@ class FerrarisOptions:
     sections: Path
     accel: LogSource | None = None
     turn_angle: float = float(np.deg2rad(-360.0))
-    gravity: float = STANDARD_GRAVITY
+    gravity: float = quantity(STANDARD_GRAVITY, "acceleration", gt=0)
     bias: Literal["pairwise", "lsq"] = "pairwise"
     g_sensitivity: bool = True
 

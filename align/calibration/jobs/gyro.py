@@ -31,7 +31,7 @@ from align.calibration.results import CalibrationSet
 from align.errors import InputError
 from align.io.logs import SensorLog
 from align.io.source import LogSource
-from align.job import Job, Progress, fields_signature
+from align.job import Job, Progress, fields_signature, quantity
 from align.units import STANDARD_GRAVITY
 from align.vocab import Sensor
 
@@ -82,14 +82,14 @@ class GyroOptions:
 
     log: LogSource
     accel: LogSource | None = None
-    gravity: float = STANDARD_GRAVITY
-    window_s: float = 1.0
-    factor: float = 6.0
-    gyro_factor: float = 1000.0
-    init_static_s: float | None = None
-    min_static_s: float = 1.0
+    gravity: float = quantity(STANDARD_GRAVITY, "acceleration", gt=0)
+    window_s: float = quantity(1.0, "time", gt=0)
+    factor: float = quantity(6.0, "dimensionless", gt=0)
+    gyro_factor: float = quantity(1000.0, "dimensionless", gt=0)
+    init_static_s: float | None = quantity(None, "time", gt=0)
+    min_static_s: float = quantity(1.0, "time", gt=0)
     intervals: str | tuple[tuple[int, int], ...] | None = None
-    gyro_range: float | None = None
+    gyro_range: float | None = quantity(None, "angular_rate", gt=0)
     drop_rotations: tuple[int, ...] = ()
     g_sensitivity: bool = False
     frame: Path | None = None

@@ -18,7 +18,7 @@ from align.calibration.thermal.sensor import Settings
 from align.errors import InputError
 from align.io.logs import SensorLog
 from align.io.source import LogSource
-from align.job import Job, Progress, fields_signature
+from align.job import Job, Progress, fields_signature, quantity
 from align.vocab import Sensor
 
 __all__ = ["ThermalOptions", "ThermalInputs", "THERMAL", "calibrate_thermal"]
@@ -68,12 +68,12 @@ class ThermalOptions:
     order: int | None = None
     max_order: int = 5
     lag: bool | None = None
-    window_s: float = 20.0
+    window_s: float = quantity(20.0, "time", gt=0)
     min_rate: float = 0.002
-    min_branch_s: float = 120.0
+    min_branch_s: float = quantity(120.0, "time", gt=0)
     hysteresis: bool = True
     reference: float | None = None
-    motion_factor: float = 100.0
+    motion_factor: float = quantity(100.0, "dimensionless", gt=0)
 
     def __post_init__(self) -> None:
         names = tuple(Sensor.parse(s).value for s in ((self.sensors,) if isinstance(self.sensors, str)
