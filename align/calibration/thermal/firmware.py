@@ -14,7 +14,9 @@ writes the same file): ``TC_A_ENABLE``, ``TC_G_ENABLE`` and per instance ``i`` (
 ``TC_Ai_ID`` (the sensor's device id, matched against the driver's), ``TC_Ai_TREF``, ``TC_Ai_TMIN``,
 ``TC_Ai_TMAX`` (C) and ``TC_Ai_Xk_j`` (``k = 0..3``, axis ``j = 0, 1, 2``) in m/s^2 (rad/s for ``TC_G``)
 per C^k: ``offset = X0 + X1 d + X2 d^2 + X3 d^3``, ``d = clip(T, TMIN, TMAX) - TREF``, corrected ``= raw -
-offset`` (before the board rotation). QGroundControl's parameter file: ``#`` comments, then ``1 <tab> 1 <tab>
+offset`` (before the board rotation). The accelerometer's ``X0`` is 0: its level at ``TREF`` (gravity on its
+axes in the chamber, its offset) is the ordinary calibration's (PX4's script fits ``x - median(x)``); the gyro's
+is its bias at ``TREF``. QGroundControl's parameter file: ``#`` comments, then ``1 <tab> 1 <tab>
 NAME <tab> VALUE <tab> TYPE`` (6: int32, 9: float).
 
 Both firmware take a cubic of the static curve only: a model of higher order is refused (refit with a
@@ -152,6 +154,8 @@ def px4(sensors: dict[str, ThermalModel], ids: dict[str, int | None], instance: 
              "# offset = X0 + X1 d + X2 d^2 + X3 d^3, d = clip(T, TMIN, TMAX) - TREF; corrected = raw - offset "
              "(TemperatureCompensation.cpp); m/s^2 and rad/s per degC^k",
              "# load with QGroundControl, then repeat the ordinary accelerometer and gyro calibration",
+             "# accelerometer: X0 = 0, its level at TREF (gravity on its axes at rest, its offset) is left to the "
+             "ordinary calibration; gyro: X0 is its bias at TREF",
              "#", "# Vehicle-Id Component-Id Name Value Type"]
     if _lags(sensors):
         lines.insert(3, f"# the thermal-lag term of the {' and '.join(_lags(sensors))} is left out: no firmware has "
@@ -169,9 +173,12 @@ def px4(sensors: dict[str, ThermalModel], ids: dict[str, int | None], instance: 
         body += [f"1\t1\tTC_{_PX[name]}_ENABLE\t1\t6", f"1\t1\t{p}_ID\t{int(dev)}\t6",
                  f"1\t1\t{p}_TMAX\t{_num(m.tmax)}\t9", f"1\t1\t{p}_TMIN\t{_num(m.tmin)}\t9",
                  f"1\t1\t{p}_TREF\t{_num(m.tref)}\t9"]
+        c = cubic[name].copy()
+        if name == "accelerometer":  # its level at TREF (gravity on its axes, its offset) is the ordinary
+            c[:, 0] = 0.0            # calibration's, not a thermal offset (process_sensor_caldata.py removes it too)
         for k in range(4):
             for j in range(3):
-                body.append(f"1\t1\t{p}_X{k}_{j}\t{_num(cubic[name][j, k])}\t9")
+                body.append(f"1\t1\t{p}_X{k}_{j}\t{_num(c[j, k])}\t9")
     return "\n".join(lines + body) + "\n"
 
 

@@ -99,9 +99,13 @@ def test_px4_file_reproduces_the_compensated_log(cubic):
     assert params["TC_A_ENABLE"] == 1 and params["TC_G0_ID"] == 2293768 and params["TC_A0_ID"] == 2293776
     assert params["TC_A0_TREF"] == pytest.approx(0.5 * (params["TC_A0_TMIN"] + params["TC_A0_TMAX"]))
     for sensor, prefix in (("accelerometer", "TC_A0"), ("gyroscope", "TC_G0")):
-        got = raw[sensor]
-        _close(_px4(params, prefix, got.data, got.temperature), models[sensor].compensate(got.data,
-                                                                                          got.temperature).data)
+        got, model = raw[sensor], models[sensor]
+        tool = model.compensate(got.data, got.temperature).data
+        fw = _px4(params, prefix, got.data, got.temperature)
+        if sensor == "accelerometer":  # its level at TREF (gravity at rest) is left to the ordinary calibration
+            assert all(params[f"TC_A0_X0_{j}"] == 0.0 for j in range(3))
+            fw = fw - model.bias(np.array([params["TC_A0_TREF"]]))[0][0]
+        _close(fw, tool)
 
 
 def test_both_clamp_as_the_tool_does_outside_the_range(cubic):
@@ -114,7 +118,7 @@ def test_both_clamp_as_the_tool_does_outside_the_range(cubic):
     model = models["accelerometer"]
     tool = model.compensate(zero, T)
     assert tool.clamped > 0 and "clamped" in tool.note
-    _close(_px4(px, "TC_A0", zero, T), tool.data)
+    _close(_px4(px, "TC_A0", zero, T) - model.bias(np.array([px["TC_A0_TREF"]]))[0][0], tool.data)
     _close(_ardupilot(ap, 1, "ACC", zero, T, 35.0) - model.bias(np.array([35.0]))[0][0], tool.data)
 
 
@@ -143,3 +147,15 @@ def test_the_files_state_their_conventions_in_comments(cubic):
     for words in ("X0 + X1 d + X2 d^2 + X3 d^3", "clip(T, TMIN, TMAX) - TREF", "lag term"):
         assert words in px
     assert all(line.startswith("#") or line.count("\t") == 4 for line in px.splitlines())
+
+
+def test_px4_file_keeps_gravity_in_the_accelerometer(cubic):
+    """Applied by PX4's formula, the file leaves a resting accelerometer reading gravity (|a| near 9.8 m/s^2):
+    a thermal offset that carried the level at TREF would zero it."""
+    result, raw = cubic
+    models = {k: s.model for k, s in result.sensors.items()}
+    params = firmware.read_px4(firmware.px4(models, {"gyroscope": 1, "accelerometer": 2}))
+    got = raw["accelerometer"]
+    fw = _px4(params, "TC_A0", got.data, got.temperature)
+    assert abs(np.median(np.linalg.norm(fw, axis=1)) - np.median(np.linalg.norm(got.data, axis=1))) < 0.2
+    assert np.median(np.linalg.norm(fw, axis=1)) > 9.0
