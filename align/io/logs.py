@@ -363,7 +363,8 @@ def read_static_log(log: str | Path, names: list[str], rate_hz: float | None, lo
     column ``time_column`` (gaps are refused with their position; its unit stated, detected or given by
     ``log_format``) unless ``rate_hz`` is given. With ``rate_hz`` and ``time_step``, the time column is read
     too (not checked) and its median step, in the file's numbers, returned as ``time_step`` (a caller compares
-    it with ``rate_hz``).
+    it with ``rate_hz``). A long stream log (:data:`align.io.streamchunks.CHUNKED_BYTES`) without ``rate_hz`` is
+    read in blocks, in bounded memory (:func:`align.io.streamchunks.stream_source`): a chunk source too.
     """
     log = Path(log)
     fmt = log_format or LogFormat()
@@ -381,9 +382,14 @@ def read_static_log(log: str | Path, names: list[str], rate_hz: float | None, lo
         if source.shape[0] == 0:
             raise InputError("holds no samples", str(log))
         return StaticLog(source, float(rate), None, False)  # its samples are checked as read (align.noise.allan)
+    from align.io.streamchunks import stream_source  # it builds on NpyChunks
+
     if rate_hz is not None:
         _check_rate(rate_hz, log)
         _rate_only(fmt, log)
+    elif (blocks := stream_source(log, names, fmt, scale, time_column)) is not None:  # a long ULog or bag
+        return StaticLog(blocks, blocks.rate_hz, blocks.time_units, False, None, blocks.stated(), blocks.source,
+                         blocks.notes)
     with_time = rate_hz is None or time_step
     got = read_table(log, ([time_column] if with_time else []) + names, time_column if with_time else None, fmt)
     stated = (got.unit(names), dict(got.source), tuple(got.notes))

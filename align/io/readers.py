@@ -125,6 +125,9 @@ class LogReader:
     folder : bool
         Whether a folder is a log of this format (a ROS 2 bag, an EuRoC dataset): ``sniff`` is then
         given the folder's file names, one per line, instead of first bytes.
+    chunks : callable, optional
+        ``chunks(path, log_format, names, rows) -> Iterator[Columns]``: the columns ``read`` gives, in blocks of
+        at most ``rows`` rows, in bounded memory (a long recording: :mod:`align.io.streamchunks`).
     """
 
     name: str
@@ -135,6 +138,7 @@ class LogReader:
     streams: bool = False
     describe: Callable[[Path, LogFormat], list[Stream]] | None = None
     folder: bool = False
+    chunks: Callable[..., Any] | None = None
 
 
 #: the registered readers, in the order they are tried by content

@@ -22,7 +22,7 @@ one: every message deserialised by rosbags instead).
 
 Public names
 ------------
-READER, read, describe, sniff
+READER, read, describe, sniff, iter_chunks
 """
 
 from __future__ import annotations
@@ -31,6 +31,7 @@ import functools
 from array import array
 from collections.abc import Iterator
 from contextlib import contextmanager
+from itertools import islice
 from pathlib import Path
 from typing import Any
 
@@ -40,7 +41,7 @@ from align.errors import InputError, literal
 from align.io.formats import LogFormat
 from align.io.readers import Columns, LogReader, Stream
 
-__all__ = ["READER", "read", "describe", "sniff"]
+__all__ = ["READER", "read", "describe", "sniff", "iter_chunks"]
 
 IMU, MAGNETIC, TEMPERATURE = "sensor_msgs/msg/Imu", "sensor_msgs/msg/MagneticField", "sensor_msgs/msg/Temperature"
 _XYZ = "xyz"
@@ -84,6 +85,13 @@ def _damaged(exc: BaseException, where: str) -> InputError:
     text = " ".join(str(exc).split())[:160] or type(exc).__name__
     return InputError(f"cannot read the bag ({literal(text)}): it is damaged or truncated (a recording cut short?); "
                       "repair it (rosbag reindex, mcap recover) or record it again", where)
+
+
+def _guarded(messages: Iterator[Any], where: str) -> Iterator[Any]:
+    try:
+        yield from messages
+    except Exception as exc:  # noqa: BLE001 - a chunk or page that cannot be read
+        raise _damaged(exc, where) from None
 
 
 @contextmanager
@@ -170,8 +178,8 @@ def _temperature_topic(topic: str, topics: dict[str, tuple[str, int]], ros1: boo
     return None, why
 
 
-def _decode(bag, topic: str, kind: str, columns: list[str], where: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Record time (ns), header stamp (ns) and the columns (n, k) of ``topic``'s messages.
+def _decode(bag, topic: str, kind: str, columns: list[str], where: str, batch=None) -> tuple[np.ndarray, ...]:
+    """Record time (ns), header stamp (ns) and the columns (n, k) of ``topic``'s messages (or of ``batch``'s).
 
     The fixed part is cut from each message's bytes (ROS 1 and CDR: the stamp at bytes 4 to 12, the float64
     fields last) and read by numpy at once; checked against rosbags' deserialiser on the first and last message.
@@ -183,20 +191,17 @@ def _decode(bag, topic: str, kind: str, columns: list[str], where: str) -> tuple
     record, raw = array("q"), bytearray()
     first = last = b""
     start, stop, need = 8 * (floats - lo), 8 * (floats - hi), 12 + 8 * floats
-    fast = True
-    try:
-        for _, stamp, data in bag.messages(connections=conns):
-            n = len(data)
-            if n < need:
-                fast = False
-                break
-            record.append(stamp)
-            raw += data[:12]
-            raw += data[n - start:n - stop]
-            first = first or data
-            last = data
-    except Exception as exc:  # noqa: BLE001 - a chunk or page that cannot be read
-        raise _damaged(exc, where) from None
+    fast, each = True, (lambda: _guarded(bag.messages(connections=conns), where)) if batch is None else (lambda: batch)
+    for _, stamp, data in each():
+        n = len(data)
+        if n < need:
+            fast = False
+            break
+        record.append(stamp)
+        raw += data[:12]
+        raw += data[n - start:n - stop]
+        first = first or data
+        last = data
     if fast and len(record):
         ros1 = not bag.is2
         dtype = np.dtype([("head", "u1", (4,)), ("sec", "<u4" if ros1 else "<i4"), ("nsec", "<u4"),
@@ -207,7 +212,7 @@ def _decode(bag, topic: str, kind: str, columns: list[str], where: str) -> tuple
         little = ros1 or bool(np.all(rows["head"][:, 1] == 1) and np.all(rows["head"][:, 0] == 0))
         if little and all(_same(bag, d, kind, header[i], values[i], columns) for i, d in ((0, first), (-1, last))):
             return np.frombuffer(record, dtype=np.int64).copy(), header, values
-    return _deserialised(bag, conns, kind, columns, fields, where)
+    return _deserialised(bag, each(), kind, columns, fields, where)
 
 
 def _field(msg, path: tuple[str, ...]) -> float:
@@ -228,11 +233,11 @@ def _same(bag, data: bytes, kind: str, header: int, values: np.ndarray, columns:
         return False
 
 
-def _deserialised(bag, conns, kind: str, columns: list[str], fields, where: str):
+def _deserialised(bag, messages, kind: str, columns: list[str], fields, where: str):
     """Every message deserialised by rosbags (a layout the fast path does not know)."""
     record, header, rows = [], [], []
     try:
-        for _, stamp, data in bag.messages(connections=conns):
+        for _, stamp, data in messages:
             msg = bag.deserialize(data, kind)
             record.append(stamp)
             header.append(int(msg.header.stamp.sec) * 1_000_000_000 + int(msg.header.stamp.nanosec))
@@ -382,10 +387,7 @@ def describe(path: Path, fmt: LogFormat) -> list[Stream]:
                 out.append(Stream(topic, _kind(kind, ros1), count))
                 continue
             conns = [c for c in bag.connections if c.topic == topic]
-            try:
-                times = [stamp for _, stamp, _ in bag.messages(connections=conns)]
-            except Exception as exc:  # noqa: BLE001 - a damaged chunk
-                raise _damaged(exc, str(path)) from None
+            times = [stamp for _, stamp, _ in _guarded(bag.messages(connections=conns), str(path))]
             span = (times[-1] - times[0]) / 1e9 if len(times) > 1 else 0.0
             cols = ("time", *_LAYOUTS[kind][1])
             extra = {"storage": _storage(path, ros1), **({"rate_hz": (len(times) - 1) / span} if span > 0 else {})}
@@ -393,5 +395,26 @@ def describe(path: Path, fmt: LogFormat) -> list[Stream]:
     return out
 
 
+def iter_chunks(path: Path, fmt: LogFormat, names: list[str] | None = None, rows: int = 100_000) -> Iterator[Columns]:
+    """The columns :func:`read` gives (no temperature joined) in blocks of ``rows`` messages, in bounded memory."""
+    where, stamps, origin = str(path), fmt.stamps or "header", None
+    with _opened(path) as bag:
+        topic = _choose(topics := _topics(bag), fmt, names, ros1 := not bag.is2, where)
+        own = ["time", *_LAYOUTS[kind := topics[topic][0]][1]]
+        _require(names, own, topic, topics, ros1, "time", "blocks of a long bag join no temperature topic", where)
+        wanted = list(names) if names is not None else own
+        source = {"format": "rosbag", "topic": topic, "type": _kind(kind, ros1), "stamps": stamps,
+                  "storage": _storage(path, ros1)}
+        messages = _guarded(bag.messages(connections=[c for c in bag.connections if c.topic == topic]), where)
+        while batch := list(islice(messages, rows)):
+            record, header, values = _decode(bag, topic, kind, list(_LAYOUTS[kind][1]), where, batch)
+            ns = _stamps(topic, record, header, stamps, where)
+            origin = int(ns[0]) if origin is None else origin
+            columns = {"time": (ns - origin) / 1e9, **dict(zip(_LAYOUTS[kind][1], values.T))}
+            yield Columns(wanted, np.column_stack([columns[n] for n in wanted]), {n: UNITS[n] for n in wanted},
+                          {**source, "time_origin_ns": origin})
+
+
 #: ROS bags: files by suffix, and a ROS 2 bag folder (its ``metadata.yaml``) by its listing
-READER = LogReader("rosbag", (".bag", ".db3", ".mcap"), read, sniff, streams=True, describe=describe, folder=True)
+READER = LogReader("rosbag", (".bag", ".db3", ".mcap"), read, sniff, streams=True, describe=describe, folder=True,
+                   chunks=iter_chunks)

@@ -415,4 +415,4 @@ def _rate(t: np.ndarray | None) -> float | None:
     return 1e6 / step if step > 0 else None
 
 
-READER = LogReader("ulog", (".ulg",), read, sniff=sniff, streams=True, describe=describe)
+READER = LogReader("ulog", (".ulg",), read, sniff=sniff, streams=True, describe=describe, chunks=iter_chunks)

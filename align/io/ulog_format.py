@@ -4,20 +4,19 @@ The format describes itself (https://docs.px4.io/main/en/dev_log/ulog_file_forma
 (the magic ``ULog 01 12 35``, a version byte, the start time, uint64 microseconds), then messages, each a
 3-byte header (``uint16 msg_size`` of what follows, ``uint8 msg_type``) and its bytes, little-endian:
 
-* definitions: ``B`` flag bits (first, if present: 8 compat and 8 incompat flag bytes, 3 uint64 offsets
-  of appended data), ``F`` a format (``name:type field;type[n] field;...``, a type being a base type or
-  another format: nested), ``I`` / ``M`` info, ``P`` / ``Q`` parameters;
+* definitions: ``B`` flag bits (8 compat, 8 incompat flag bytes, 3 uint64 offsets of appended data), ``F`` a
+  format (``name:type field;type[n] field;...``, a type a base type or a format), ``I``/``M``, ``P``/``Q``;
 * data: ``A`` a subscription (``uint8 multi_id``, ``uint16 msg_id``, the format's name), ``R`` its end,
   ``D`` a sample (``uint16 msg_id``, then the fields packed with no padding but the ``_padding`` fields
   the format names; a trailing one is not logged), ``L`` / ``C`` log text, ``S`` a sync marker (8 bytes,
   :data:`SYNC`), ``O`` a dropout (``uint16`` ms lost), ``I`` / ``M`` / ``P`` again.
 
 :class:`Scan` walks the messages by their sizes (one step per message, nothing else; compiled for a large file)
-window by window of the file's bytes; each window's ``D`` records are told apart by their ``msg_id`` with numpy.
-:func:`decode` reads the records of one topic with one structured dtype. A message the file cuts short ends the
-scan, bytes that are no message (an unknown type byte, a zero size) are skipped to the next sync marker (both
-stated); data appended after a crash (the ``DATA_APPENDED`` flag bit) is read from its offsets on.
-:func:`match` and :class:`Join` pair two sensors' samples by their stamps (the joined ``imu:N`` view).
+window by window of the file's bytes (the pages of windows read released); each window's ``D`` records are told
+apart by their ``msg_id`` with numpy; :func:`decode` reads one topic's records with one structured dtype. A
+message cut short ends the scan, bytes that are no message are skipped to the next sync marker (both stated);
+data appended after a crash (``DATA_APPENDED``) is read from its offsets on. :func:`match` and :class:`Join`
+pair two sensors' samples by their stamps (the joined ``imu:N`` view).
 
 Public names
 ------------
@@ -38,8 +37,7 @@ import numpy as np
 
 from align.errors import InputError, literal
 
-__all__ = ["MAGIC", "SYNC", "TYPES", "Layout", "layout", "parse_format", "sniff", "Scan", "decode", "match", "tolerance",
-           "Join"]
+__all__ = ["MAGIC", "SYNC", "TYPES", "Layout", "layout", "parse_format", "sniff", "Scan", "decode", "match", "tolerance", "Join"]
 
 #: the first 7 bytes of every ULog file
 MAGIC = b"ULog\x01\x12\x35"
@@ -57,6 +55,7 @@ _COMPILED: list = []
 _FIELD = re.compile(r"\s*([A-Za-z0-9_]+)\s*(?:\[\s*(\d+)\s*\])?\s+([A-Za-z0-9_]+)\s*")
 _LETTER = np.isin(np.arange(256), [*range(65, 91), *range(97, 123)])
 _D, _A, _R, _F, _O, _B = (ord(c) for c in "DARFOB")
+_DONTNEED = lambda mm: isinstance(mm, mmap.mmap) and hasattr(mmap, "MADV_DONTNEED")  # noqa: E731
 
 
 def sniff(head: bytes) -> bool:
@@ -264,6 +263,8 @@ class Scan:
                 bad = np.flatnonzero((size == 0) | ~_LETTER[kind])
                 k = int(bad[0]) if len(bad) else len(offs)
                 yield self._window(offs[:k], kind[:k], size[:k])
+                if (done := int(offs[0]) // mmap.PAGESIZE * mmap.PAGESIZE if k else 0) and _DONTNEED(mm):
+                    mm.madvise(mmap.MADV_DONTNEED, 0, done)  # the windows read: their pages go (bounded memory)
                 if len(bad):
                     lost = int(offs[k])
                     found = mm.find(SYNC, lost, end)
