@@ -6,11 +6,13 @@ Measures, on the same lot:
      parsing, the same job, the JSON, the summary), in wall time and CPU time;
   2. the whole `imu-align batch MANIFEST --workers N` process (start-up included) with 1 and 2 workers:
      throughput (units/s), per-unit wall time and its overhead over the library job (target < 10 %), the same in
-     CPU time (the whole process tree's: what other users of a shared machine cannot inflate), and the scaling
-     efficiency from 1 to 2 workers, T1 / (2 T2) (target >= 80 %);
-  3. peak RSS (the largest process: the batch or one of its workers) with 200 and 1,000 units (the 1,000-unit
-     manifest lists the 200 sessions five times under other serials: the batch keeps nothing per unit, so
-     memory stays flat as the lot grows).
+     CPU time (the whole process tree's: what other users of a shared machine inflate least; split into the batch
+     process's own and its workers'), the same against the library job over the lot in one plain process (its
+     start-up included), and the scaling efficiency from 1 to 2 workers, T1 / (2 T2) (target >= 80 %);
+  3. with --big, the slope of the batch's wall and CPU time over the lot's size (start-up taken out: the per-unit
+     overhead, target < 10 %), and peak RSS (the largest process: the batch or one of its workers) with 200 and
+     1,000 units (the 1,000-unit manifest lists the 200 sessions five times under other serials: the batch keeps
+     nothing per unit, so memory stays flat as the lot grows).
 Every file is made in a temporary folder, removed at the end (also on a failure), unless --keep.
 
     python bench/bench_batch.py [--units 200] [--big 1000] [--repeat 1] [--dask] [--keep DIR] [--no-bytecode]
@@ -25,6 +27,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import NamedTuple
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -94,7 +97,16 @@ def big_manifest(lot, n: int) -> Path:
     return path
 
 
-def run_tree(cmd: list[str]) -> tuple[float, float, float]:
+class Run(NamedTuple):
+    """What :func:`run_tree` measured of one process tree."""
+
+    wall: float  #: s
+    cpu: float  #: s, user + system of every process (NaN without psutil)
+    rss: float  #: MB, the largest process's peak
+    own: float  #: s, CPU of the top process alone (the batch: reading, preparing, journaling, folding)
+
+
+def run_tree(cmd: list[str]) -> Run:
     """Wall time (s), CPU time (user + system, s) and peak RSS (MB, the largest process) of ``cmd`` and every
     process under it: its workers are counted (a fork server's are not its children, so its own rusage misses
     them), sampled every 20 ms with psutil; without psutil, CPU is NaN and RSS the largest child's."""
@@ -102,7 +114,7 @@ def run_tree(cmd: list[str]) -> tuple[float, float, float]:
         import psutil
     except ImportError:
         wall, _, rss = measure_cpu(cmd)
-        return wall, float("nan"), rss
+        return Run(wall, float("nan"), rss, float("nan"))
     seen: dict[int, float] = {}
     peak = 0
     t0 = time.perf_counter()
@@ -119,7 +131,7 @@ def run_tree(cmd: list[str]) -> tuple[float, float, float]:
     wall = time.perf_counter() - t0
     if proc.returncode != 0:
         raise SystemExit(f"failed: {' '.join(cmd)}\n{proc.stderr.read().decode()}")
-    return wall, sum(seen.values()), peak / 2**20
+    return Run(wall, sum(seen.values()), peak / 2**20, seen.get(proc.pid, float("nan")))
 
 
 _PLAIN = (
@@ -133,15 +145,13 @@ _PLAIN = (
 )
 
 
-def plain_process(lot) -> tuple[float, float]:
+def plain_process(lot) -> Run:
     """Wall and CPU time of the library job over every unit of the lot in one plain Python process (its start
     and imports included; no JSON, no table): what any process of the jobs costs."""
-    wall, cpu, _ = run_tree([sys.executable, "-c", _PLAIN, str(lot.folder)])
-    return wall, cpu
+    return run_tree([sys.executable, "-c", _PLAIN, str(lot.folder)])
 
 
-def batch(manifest: Path, out: Path, workers: int, scheduler: str | None = None, tag: str = "0"
-          ) -> tuple[float, float, float]:
+def batch(manifest: Path, out: Path, workers: int, scheduler: str | None = None, tag: str = "0") -> Run:
     """Wall time, CPU time (every process) and peak RSS of one whole batch process into a fresh output folder."""
     cmd = [sys.executable, "-m", "align.cli", "batch", str(manifest), "--workers", str(workers)]
     cmd += ["--scheduler", scheduler] if scheduler else []
@@ -179,57 +189,60 @@ def run(args: argparse.Namespace, folder: Path) -> None:
           f"(CPU {1e3 * cpu0:6.1f} ms); single command via align.cli.run {1e3 * cmd:6.1f} ms (CPU {1e3 * cmd_cpu:6.1f} ms)")
     # side by side, the best of --repeat rounds of: the library job, a batch of 1 worker, the library job, a batch
     # of 2 workers (a shared machine's load drifts: each ratio is of figures taken minutes apart at most)
-    lib, t1, t2 = [lib0], [], []
-    cpu, c1, c2, m1, m2 = [cpu0], [], [], 0.0, 0.0
+    lib, cpu = [lib0], [cpu0]
+    runs: dict[int, list[Run]] = {1: [], 2: []}
     for r in range(args.repeat):
-        if r:
-            (w, c), _ = in_process(lot, command=False)
-            lib.append(w)
-            cpu.append(c)
-        t, c, m = batch(lot.manifest, folder / "out", 1, tag=str(r))
-        t1.append(t), c1.append(c)
-        m1 = max(m1, m)
-        (w, c), _ = in_process(lot, command=False)
-        lib.append(w)
-        cpu.append(c)
-        t, c, m = batch(lot.manifest, folder / "out", 2, tag=str(r))
-        t2.append(t), c2.append(c)
-        m2 = max(m2, m)
+        for w in (1, 2):
+            if r or w == 2:
+                (t, c), _ = in_process(lot, command=False)
+                lib.append(t)
+                cpu.append(c)
+            runs[w].append(batch(lot.manifest, folder / "out", w, tag=str(r)))
     n = args.units
     lib_best, cpu_best = min(lib), min(cpu)
-    for w, t, c, m in ((1, min(t1), min(c1), m1), (2, min(t2), min(c2), m2)):
-        per, per_cpu = t / n * w, c / n
-        print(f"batch --workers {w}: {t:6.2f} s  {n / t:6.2f} units/s  {1e3 * per:6.1f} ms per unit per worker, "
-              f"library job {1e3 * lib_best:6.1f} ms: overhead {1e3 * (per - lib_best):+6.1f} ms, "
+    best = {w: _best(rs) for w, rs in runs.items()}
+    for w, b in best.items():
+        per, per_cpu = b.wall / n * w, b.cpu / n
+        print(f"batch --workers {w}: {b.wall:6.2f} s  {n / b.wall:6.2f} units/s  {1e3 * per:6.1f} ms per unit per "
+              f"worker, library job {1e3 * lib_best:6.1f} ms: overhead {1e3 * (per - lib_best):+6.1f} ms, "
               f"{100 * (per / lib_best - 1):+5.1f} %; CPU (every process) {1e3 * per_cpu:6.1f} ms per unit vs "
-              f"{1e3 * cpu_best:6.1f} ms: {100 * (per_cpu / cpu_best - 1):+5.1f} %; peak RSS {m:6.1f} MB")
+              f"{1e3 * cpu_best:6.1f} ms: {100 * (per_cpu / cpu_best - 1):+5.1f} % (the batch process "
+              f"{1e3 * b.own / n:4.1f} ms, its workers {1e3 * (b.cpu - b.own) / n:5.1f} ms); "
+              f"peak RSS {max(x.rss for x in runs[w]):6.1f} MB")
     inside = worker_seconds(folder / "out" / "w1-0" / "results.parquet")
     print(f"in a worker (--workers 1, the table's seconds, first unit left out): {1e3 * inside:6.1f} ms per unit "
           f"(job + JSON + rows)")
-    pw, pc = plain_process(lot)
+    plain = plain_process(lot)
+    pw, t1, t2 = plain.wall, best[1].wall, best[2].wall
     print(f"the library job over the lot in one plain process (start-up included, no JSON, no table): {pw:6.2f} s, "
-          f"{1e3 * pw / n:6.1f} ms per unit ({100 * (pw / n / lib_best - 1):+5.1f} % over the library job in-process); "
-          f"batch --workers 1 over it: {100 * (min(t1) / pw - 1):+5.1f} %")
-    print(f"scaling 1 -> 2 workers: {min(t1) / min(t2):.2f}x, efficiency {100 * min(t1) / (2 * min(t2)):.0f} % "
-          "(target >= 80 %)")
+          f"{1e3 * pw / n:6.1f} ms per unit ({100 * (pw / n / lib_best - 1):+5.1f} % over the library job in-process), "
+          f"CPU {plain.cpu:6.2f} s; batch --workers 1 over it: {t1 - pw:+5.2f} s, {100 * (t1 / pw - 1):+5.1f} % "
+          f"(CPU {best[1].cpu - plain.cpu:+5.2f} s, {100 * (best[1].cpu / plain.cpu - 1):+5.1f} %)")
+    print(f"scaling 1 -> 2 workers: {t1 / t2:.2f}x, efficiency {100 * t1 / (2 * t2):.0f} % (target >= 80 %)")
     print("rounds (wall s, w1 / w2; library ms): " + "; ".join(
-        f"{a:.2f} / {b:.2f}" for a, b in zip(t1, t2)) + "; " + ", ".join(f"{1e3 * x:.1f}" for x in lib))
+        f"{a.wall:.2f} / {b.wall:.2f}" for a, b in zip(runs[1], runs[2])) + "; " + ", ".join(f"{1e3 * x:.1f}" for x in lib))
     if args.dask:
-        td, _, md = batch(lot.manifest, folder / "out", 2, "local")
-        print(f"batch --scheduler local --workers 2: {td:6.2f} s  {n / td:6.2f} units/s  peak RSS {md:6.1f} MB")
+        d = batch(lot.manifest, folder / "out", 2, "local")
+        print(f"batch --scheduler local --workers 2: {d.wall:6.2f} s  {n / d.wall:6.2f} units/s  peak RSS {d.rss:6.1f} MB")
     if args.big:
         # the per-unit cost with the fixed start-up (interpreter, imports, pool, the table's first write) taken
         # out: the slope of the batch's wall time over the lot's size, one worker, against the library job
         big = big_manifest(lot, args.big)
-        tb1, _, _ = batch(big, folder / "out", 1, tag="big1")
-        slope = (tb1 - min(t1)) / (args.big - n)
-        print(f"batch --workers 1, {n} and {args.big} units: {min(t1):.2f} s and {tb1:.2f} s; per unit beyond the "
+        b1 = _best([batch(big, folder / "out", 1, tag=f"big1-{r}") for r in range(args.repeat)])
+        slope, slope_cpu = (b1.wall - t1) / (args.big - n), (b1.cpu - best[1].cpu) / (args.big - n)
+        print(f"batch --workers 1, {n} and {args.big} units: {t1:.2f} s and {b1.wall:.2f} s; per unit beyond the "
               f"start-up (the slope) {1e3 * slope:6.1f} ms vs the library job {1e3 * lib_best:6.1f} ms: overhead "
-              f"{100 * (slope / lib_best - 1):+5.1f} % (target < 10 %); fixed start-up {min(t1) - n * slope:.2f} s")
-        tb, _, mb = batch(big, folder / "out", 2, tag="big")
-        print(f"batch of {args.big} units, --workers 2: {tb:6.2f} s  {args.big / tb:6.2f} units/s  peak RSS {mb:6.1f} MB "
-              f"(vs {m2:.1f} MB for {n}: {'flat' if mb < 1.15 * m2 else 'GROWS'})")
+              f"{100 * (slope / lib_best - 1):+5.1f} % (target < 10 %); fixed start-up {t1 - n * slope:.2f} s; "
+              f"in CPU {1e3 * slope_cpu:6.1f} ms vs {1e3 * cpu_best:6.1f} ms: {100 * (slope_cpu / cpu_best - 1):+5.1f} %")
+        bb = batch(big, folder / "out", 2, tag="big")
+        m2 = max(x.rss for x in runs[2])
+        print(f"batch of {args.big} units, --workers 2: {bb.wall:6.2f} s  {args.big / bb.wall:6.2f} units/s  peak RSS "
+              f"{bb.rss:6.1f} MB (vs {m2:.1f} MB for {n}: {'flat' if bb.rss < 1.15 * m2 else 'GROWS'})")
 
+
+def _best(runs: list[Run]) -> Run:
+    """The run of the least wall time."""
+    return min(runs, key=lambda r: r.wall)
 
 if __name__ == "__main__":
     main()

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import difflib
 import enum
+import functools
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -181,13 +182,16 @@ def error_line(job: str, exc: BaseException) -> tuple[int, str]:
     return 1, f"{PROG}: internal error: {_internal(exc)} (set IMU_ALIGN_DEBUG=1 for details)"
 
 
-def _output_names(job: str) -> set[str]:
-    """The parameters (Python names) of ``job``'s command that name files it writes."""
-    return {p.name for p in _click(job).params if set(getattr(p, "opts", ())) & set(OUTPUT_OPTIONS)}
+@functools.cache
+def _output_names(job: str) -> frozenset[str]:
+    """The parameters (Python names) of ``job``'s command that name files it writes (once per job)."""
+    return frozenset({p.name for p in _click(job).params if set(getattr(p, "opts", ())) & set(OUTPUT_OPTIONS)})
 
 
+@functools.cache
 def _path_params(job: str) -> frozenset[str]:
-    """The parameters of ``job``'s command declared as paths (typer gives some click versions' values as text)."""
+    """The parameters of ``job``'s command declared as paths (typer gives some click versions' values as text;
+    its type hints evaluated once per job: a few milliseconds each time)."""
     import typing
 
     callback = _click(job).callback
@@ -235,10 +239,11 @@ def _hashed(unit, files) -> tuple[Path | None, ...]:
 
 
 def _parsed(unit, folder: Path, where: str, cache: dict | None) -> dict[str, Any]:
-    """The command's parameters for the unit's row, as click parses them (values not yet resolved).
+    """The command's parameters for the unit's row, as click parses them, paths resolved against ``folder``.
 
-    Rows of one job with the same options words differ only in their log and plan: those are parsed once
-    (``cache``), the log and plan put in place for each row (a path's value is not checked when parsed).
+    Rows of one job with the same options words differ only in their log and plan: those are parsed and resolved
+    once (``cache``), the row's log and plan (resolved by the manifest's reader) put in place for each row (a
+    path's value is not checked when parsed).
     """
     from align.cli import _usage_message
     from align.cli.options import rewrite_aliases
@@ -247,7 +252,7 @@ def _parsed(unit, folder: Path, where: str, cache: dict | None) -> dict[str, Any
     flag = JOBS[unit.job][0]
     log_name = next(p.name for p in command.params if getattr(p, "param_type_name", "") == "argument")
     plan_name = next((p.name for p in command.params if flag in getattr(p, "opts", ())), None) if flag else None
-    key = (unit.job, unit.options, unit.plan is None)
+    key = (unit.job, unit.options, unit.plan is None, folder)
     if cache is not None and key in cache:
         params = dict(cache[key])
     else:
@@ -261,6 +266,8 @@ def _parsed(unit, folder: Path, where: str, cache: dict | None) -> dict[str, Any
                 raise
             what = " ".join(_usage_message(exc, unit.job.split(), args).split())
             raise InputError(f"{unit.row}, column options: {what}", where) from None
+        paths = _path_params(unit.job)
+        params = {name: _absolute(value, folder, name in paths) for name, value in params.items()}
         if cache is not None:
             cache[key] = dict(params)
     params[log_name] = unit.log
@@ -296,9 +303,7 @@ def prepare_unit(unit, folder: Path, where: str, cache: dict | None = None) -> P
     from align.cli.builders import options_builder
     from align.cli.paths import check_outputs
 
-    paths = _path_params(unit.job)
-    params = {name: _absolute(value, folder, name in paths)
-              for name, value in _parsed(unit, folder, where, cache).items()}
+    params = _parsed(unit, folder, where, cache)
     outs = _output_names(unit.job)
     asked = {name: params[name] for name in outs if params.get(name) is not None}
     try:  # as the single command: its outputs checked, then its options built

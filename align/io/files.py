@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import codecs
 import json
+import math
 import os
 import tempfile
 import tomllib
@@ -187,6 +188,15 @@ def write_json(path: str | Path, data: dict) -> None:
 
 def to_json_value(x):
     """``x`` with numpy arrays and scalars as plain lists and numbers; NaN and inf as None."""
+    t = type(x)  # the plain types first, by identity (most of a result's values; the batch writes one per unit)
+    if t is float:
+        return x if math.isfinite(x) else None
+    if t is dict:
+        return {k: to_json_value(v) for k, v in x.items()}
+    if t is list or t is tuple:
+        return [to_json_value(v) for v in x]
+    if t is str or t is int or t is bool or x is None:
+        return x
     if isinstance(x, dict):
         return {k: to_json_value(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):

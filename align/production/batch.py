@@ -242,16 +242,30 @@ def plan_tasks(units: Iterable[Unit], out: Path, make: Callable[[Unit, Path, str
     last: dict[tuple[str, str], list[dict]] = {}
     for r in latest_rows(read_table(table_path)):
         last.setdefault((r["serial"], r["job"]), []).append(r)
+    tasks = [(unit, make(unit, out / UNITS / unit.result_name, run)) for unit in units]
+    done = [] if rerun else [(unit, task) for unit, task in tasks if task.result.exists()
+                             and last.get((unit.serial, unit.job), [{}])[0].get("status") == "ok"]
+    digests = _digests([task for _, task in done])
     todo, skipped = [], []
-    for unit in units:
-        task = make(unit, out / UNITS / unit.result_name, run)
+    for unit, task in tasks:
         prev = last.get((unit.serial, unit.job))
-        if (not rerun and prev is not None and prev[0]["status"] == "ok" and task.result.exists()
-                and prev[0]["input_hash"] == task.digest()):
+        if digests.get(id(task)) is not None and prev is not None and prev[0]["input_hash"] == digests[id(task)]:
             skipped += [{**r, "order": unit.order, "slot": unit.slot} for r in prev]
             continue
         todo.append(task)
     return todo, skipped
+
+
+def _digests(tasks: list[Task]) -> dict[int, str]:
+    """``id(task) -> task.digest()``, the files read and hashed in threads (``hashlib`` and file reads release the
+    GIL: a rerun of a long lot is not one SHA-256 after another); the threads are gone on return, so that the
+    pool's workers may still be forks of this process."""
+    if len(tasks) < 2:
+        return {id(t): t.digest() for t in tasks}
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(min(8, os.cpu_count() or 1, len(tasks))) as ex:
+        return dict(zip(map(id, tasks), ex.map(Task.digest, tasks)))
 
 
 def run_units(tasks: list[Task], worker: Callable[[Task], list[dict]], pool, out: Path,

@@ -247,7 +247,8 @@ def input_hash(job: str, options: Iterable[str], files: Iterable[Path | None],
     files : iterable of Path or None
     known : mapping of str -> str, optional
         Path -> SHA-256 (hex) of files hashed already (a result's provenance, :class:`align.provenance.InputFile`):
-        not read again; an empty digest stands for a file that could not be read.
+        not read again; an empty digest stands for a file that could not be read. The others are hashed as the
+        provenance hashes them, so that both give one digest.
     """
     from align import __version__
 
@@ -263,14 +264,12 @@ def input_hash(job: str, options: Iterable[str], files: Iterable[Path | None],
 
 
 def _file_digest(path: Path | None) -> bytes:
-    """SHA-256 of a file's bytes; fixed tags for no file and a missing (unreadable) one."""
+    """SHA-256 of an input's bytes, as its result's provenance records it (:func:`align.provenance.file_record`: a
+    file's bytes; a log folder's files, where the provenance reads folders); fixed tags for no file and a missing
+    (unreadable) one."""
+    from align.provenance import file_record
+
     if path is None:
         return b"none"
-    inner = hashlib.sha256()
-    try:
-        with open(path, "rb") as fh:
-            for block in iter(lambda: fh.read(1 << 20), b""):
-                inner.update(block)
-    except OSError:
-        return b"missing"
-    return inner.digest()
+    hexed = file_record("", path).sha256
+    return bytes.fromhex(hexed) if hexed else b"missing"

@@ -12,6 +12,10 @@ beside the table (``results.parquet.journal``, flushed per unit); the journal is
 table at the end of the run, or at the start of the next one when the run was killed. So a killed
 batch loses at most the units that were running.
 
+The table is read, built and written with pyarrow alone (its file reader, arrays made from their buffers):
+``pyarrow.array`` on Python objects, ``pyarrow.parquet.read_table`` (the dataset layer) and a timestamp's
+``to_pylist`` import pandas, a third of a second a batch would spend before or between its units.
+
 Columns: :data:`META` (serial, slot, order, run, time (UTC), job, sensor, status, exit_code,
 message, verdict, checks, input_hash, result, seconds, worker, bias_unit), then every figure of
 :data:`align.production.keyfigures.FIGURES` (float64, SI; each field's metadata holds its unit).
@@ -26,10 +30,11 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Iterable
-from datetime import UTC, datetime
+from datetime import UTC, datetime, timedelta
 from pathlib import Path
-from typing import TextIO
+from typing import Any, TextIO
 
+import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
@@ -82,10 +87,122 @@ def _unified(tables: list[pa.Table]) -> list[pa.Table]:
     schema = pa.unify_schemas([t.schema for t in tables])
     out = []
     for t in tables:
-        cols = [t.column(f.name).cast(f.type) if f.name in t.column_names else pa.nulls(len(t), f.type)
+        cols = [_as(t.column(f.name), f.type) if f.name in t.column_names else pa.nulls(len(t), f.type)
                 for f in schema]
         out.append(pa.Table.from_arrays(cols, schema=schema))
     return out
+
+
+def _as(column: pa.ChunkedArray, kind: pa.DataType) -> pa.ChunkedArray:
+    """``column`` of type ``kind`` (cast only when it is another: a cast loads pyarrow's compute functions)."""
+    return column if column.type == kind else column.cast(kind)
+
+
+#: the types of a row's values a column takes as they are (the common case, checked at once)
+_WHOLE = frozenset({type(None), int, np.int64, np.int32})
+_REAL = _WHOLE | {float, np.float64}
+_EPOCH = datetime(1970, 1, 1)
+_EPOCH_UTC = _EPOCH.replace(tzinfo=UTC)
+_MICRO = timedelta(microseconds=1)
+
+
+def _array(name: str, values: list, kind: pa.DataType) -> pa.Array:
+    """An Arrow array of ``values`` (None: null) of the schema's ``kind`` (string, int64, float64 or a timestamp
+    in microseconds), built from its buffers (Arrow columnar format: validity bitmap, offsets, data).
+
+    Examples
+    --------
+    >>> _array("x", [1.5, None], pa.float64()).to_pylist()
+    [1.5, None]
+    >>> _array("s", ["a", None, "bc"], pa.string()).to_pylist()
+    ['a', None, 'bc']
+    """
+    n = len(values)
+    valid = np.fromiter((v is not None for v in values), dtype=bool, count=n)
+    nulls = n - int(valid.sum())
+    bitmap = pa.py_buffer(np.packbits(valid, bitorder="little")) if nulls else None
+    if pa.types.is_string(kind):
+        data = [_text(name, v).encode() for v in values]
+        offsets = np.zeros(n + 1, dtype=np.int32)
+        np.cumsum([len(b) for b in data], out=offsets[1:])
+        return pa.Array.from_buffers(kind, n, [bitmap, pa.py_buffer(offsets), pa.py_buffer(b"".join(data))], nulls)
+    if pa.types.is_timestamp(kind) and kind.unit == "us":
+        numbers = np.array([_micros(name, v) for v in values], dtype=np.int64)
+    elif pa.types.is_int64(kind):
+        plain = all(type(v) in _WHOLE for v in values)  # else each value checked (and refused with its column)
+        numbers = np.array([0 if v is None else v for v in values] if plain else
+                           [_number(name, v, int) for v in values], dtype=np.int64)
+    elif pa.types.is_float64(kind):
+        plain = all(type(v) in _REAL for v in values)
+        numbers = np.array([0.0 if v is None else v for v in values] if plain else
+                           [_number(name, v, float) for v in values], dtype=np.float64)
+    else:  # not a type of SCHEMA
+        raise TypeError(f"column {name}: no builder for {kind}")
+    return pa.Array.from_buffers(kind, n, [bitmap, pa.py_buffer(numbers)], nulls)
+
+
+def _text(name: str, v: Any) -> str:
+    if v is None:
+        return ""
+    if not isinstance(v, str):
+        raise TypeError(f"column {name}: {v!r} is not text")
+    return v
+
+
+def _number(name: str, v: Any, kind: type) -> Any:
+    """A number for the column (as pyarrow takes one: a bool as 0/1, a whole float in an integer column)."""
+    if v is None:
+        return 0
+    if not isinstance(v, (int, float, np.integer, np.floating)):
+        raise TypeError(f"column {name}: {v!r} is not a number")
+    if kind is int and isinstance(v, (float, np.floating)) and not float(v).is_integer():
+        raise TypeError(f"column {name}: {v!r} is not a whole number")
+    return v
+
+
+def _micros(name: str, v: Any) -> int:
+    """Microseconds since 1970-01-01 UTC (a time without a zone taken as UTC, as pyarrow takes it; an integer
+    as the count itself)."""
+    if v is None:
+        return 0
+    if isinstance(v, (int, np.integer)) and not isinstance(v, bool):
+        return int(v)
+    if not isinstance(v, datetime):
+        raise TypeError(f"column {name}: {v!r} is not a time")
+    return (v - (_EPOCH if v.tzinfo is None else _EPOCH_UTC)) // _MICRO
+
+
+def _table(rows: list[dict]) -> pa.Table:
+    """The rows (cleaned, :func:`_clean`) as a table of :data:`SCHEMA`."""
+    return pa.Table.from_arrays([_array(f.name, [r[f.name] for r in rows], f.type) for f in SCHEMA], schema=SCHEMA)
+
+
+def _times(column: pa.ChunkedArray) -> list[datetime | None]:
+    """A timestamp column's values as datetimes (from its integers: a timestamp's own ``to_pylist`` imports pandas).
+
+    Examples
+    --------
+    >>> _times(pa.chunked_array([pa.array([1_500_000, None], pa.int64()).view(pa.timestamp("us", tz="UTC"))]))
+    [datetime.datetime(1970, 1, 1, 0, 0, 1, 500000, tzinfo=datetime.timezone.utc), None]
+    """
+    kind = column.type
+    epoch = _EPOCH_UTC if kind.tz else _EPOCH
+    zone = _zone(kind.tz) if kind.tz not in (None, "UTC", "utc", "Z", "+00:00") else None
+    out: list[datetime | None] = []
+    for v in column.combine_chunks().view(pa.int64()).to_pylist() if len(column) else []:
+        if v is None:
+            out.append(None)
+            continue
+        micros = v // 1000 if kind.unit == "ns" else v * {"s": 1_000_000, "ms": 1_000, "us": 1}[kind.unit]
+        t = epoch + timedelta(microseconds=micros)
+        out.append(t.astimezone(zone) if zone is not None else t)
+    return out
+
+
+def _zone(name: str) -> Any:
+    from zoneinfo import ZoneInfo
+
+    return ZoneInfo(name)
 
 
 def read_table(path: str | Path) -> pa.Table:
@@ -102,7 +219,8 @@ def read_table(path: str | Path) -> pa.Table:
     if p.is_dir():
         raise InputError("is a folder; give the table's .parquet file", str(p))
     try:
-        table = pq.read_table(p)
+        with pq.ParquetFile(p) as fh:  # not pq.read_table: its dataset layer imports pandas
+            table = fh.read()
     except Exception as exc:  # pyarrow raises several types for a damaged or foreign file
         raise InputError(f"not a readable Parquet table ({' '.join(str(exc).split())[:200]})", str(p)) from None
     fmt = (table.schema.metadata or {}).get(b"format", b"").decode(errors="replace")
@@ -128,10 +246,10 @@ def append_rows(path: str | Path, rows: Iterable[dict], chunk: int = 256, old: p
     for r in rows:
         batch.append(_clean(r))
         if len(batch) == chunk:
-            parts.append(pa.Table.from_pylist(batch, schema=SCHEMA))
+            parts.append(_table(batch))
             batch = []
     if batch:
-        parts.append(pa.Table.from_pylist(batch, schema=SCHEMA))
+        parts.append(_table(batch))
     added = sum(p.num_rows for p in parts)
     if not added:
         return 0
@@ -149,7 +267,13 @@ def rows_of(table: pa.Table, figures: Iterable[str] | None = None) -> list[dict]
     if figures is not None:
         keep = [n for n, _ in META] + list(figures)
         table = table.select([n for n in table.column_names if n in keep])
-    rows = table.to_pylist()
+    stamps = [n for n, t in zip(table.column_names, table.schema.types) if pa.types.is_timestamp(t)]
+    rows = table.drop_columns(stamps).to_pylist() if stamps else table.to_pylist()
+    for name in stamps:
+        for r, t in zip(rows, _times(table.column(name))):
+            r[name] = t
+    if stamps:  # the table's column order
+        rows = [{n: r[n] for n in table.column_names} for r in rows]
     figures = [f for f in FIGURES if f in table.column_names]
     for r in rows:
         for f in figures:
@@ -191,7 +315,6 @@ class Journal:
         keeps them; not synced to the disk: a power cut may lose the last units, which a rerun then redoes)."""
         if self._fh is None:
             self._fh = open(self.path, "a", encoding="utf-8")
-            _warm()
         fh = self._fh
         for r in rows:
             fh.write(json.dumps({k: (v.isoformat() if isinstance(v, datetime) else v) for k, v in r.items()},
@@ -210,12 +333,6 @@ class Journal:
             n = append_rows(self.table, _fresh(old, _lines(fh)), old=old)
         self.path.unlink()
         return n
-
-
-def _warm() -> None:
-    """Make pyarrow ready to turn Python rows into a table now, while the workers compute, rather than in the
-    fold at the end: its first conversion imports pandas (a third of a second)."""
-    pa.array([0.0], type=pa.float64())
 
 
 def _key(row: dict) -> tuple:

@@ -84,3 +84,48 @@ def test_workers_are_forks_only_when_that_is_safe(monkeypatch):
     finally:
         stop.set()
         other.join()
+
+
+def _content_hash(job: str, options: tuple[str, ...], files: list[Path]) -> str:
+    """The content hash as input_hash documents it, written here from its description: imu-align's version, the
+    SHA-256 of the job and options joined by NUL, the SHA-256 of each file's bytes."""
+    import hashlib
+
+    from align import __version__
+
+    h = hashlib.sha256(b"imu-align batch inputs 1\0" + str(__version__).encode() + b"\0")
+    h.update(hashlib.sha256("\0".join([job, *options]).encode()).digest())
+    for f in files:
+        h.update(hashlib.sha256(f.read_bytes()).digest())
+    return h.hexdigest()
+
+
+def test_a_rerun_skips_the_units_done_with_unchanged_inputs_and_leaves_no_thread(tmp_path):
+    # the units' files are hashed in threads: the skip decisions are those of the content hash, and the pool's
+    # workers may still be forks of the batch afterwards
+    import threading
+    from datetime import UTC, datetime
+
+    from align.production import plan_tasks
+    from align.production.table import append_rows
+
+    tasks = _tasks(tmp_path, 6)
+    for k, t in enumerate(tasks):
+        t.unit.log.write_bytes(f"time,x\n0,{k}\n".encode())
+        t.result.parent.mkdir(exist_ok=True)
+        if k != 4:  # U4's result is gone: it runs again
+            t.result.write_text("{}")
+    rows = [{"serial": t.unit.serial, "order": k, "run": "run0", "time": datetime(2026, 3, 1, tzinfo=UTC), "job": "allan",
+             "status": "failed" if k == 5 else "ok", "exit_code": 0,  # U5 failed before: it runs again
+             "input_hash": _content_hash("allan", (), [t.unit.log])} for k, t in enumerate(tasks)]
+    append_rows(tmp_path / "results.parquet", rows)
+    tasks[3].unit.log.write_bytes(b"time,x\n0,33\n")  # U3's log changed: it runs again
+    threads = set(threading.enumerate())  # (a thread of an earlier test may end meanwhile: new ones count)
+    by_serial = {t.unit.serial: t for t in tasks}
+    todo, skipped = plan_tasks([t.unit for t in tasks], tmp_path, lambda u, result, run: by_serial[u.serial], "run1")
+    assert [t.unit.serial for t in todo] == ["U3", "U4", "U5"]
+    assert [r["serial"] for r in skipped] == ["U0", "U1", "U2"]
+    assert not set(threading.enumerate()) - threads
+    todo, skipped = plan_tasks([t.unit for t in tasks], tmp_path, lambda u, result, run: by_serial[u.serial], "run1",
+                               rerun=True)
+    assert len(todo) == 6 and not skipped

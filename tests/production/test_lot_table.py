@@ -72,3 +72,59 @@ def test_a_file_that_is_not_a_table_is_one_error(tmp_path):
         read_table(bad)
     with pytest.raises(InputError, match="is a folder"):
         read_table(tmp_path)
+
+
+def test_rows_are_built_as_pyarrow_builds_them_from_python_objects(tmp_path):
+    # the table is built from Arrow buffers (no pandas); pyarrow's own converter is the reference
+    from align.production.table import SCHEMA, _clean, _table
+
+    rows = [_row("U1", 0), {**_row("U2", 1.5), "message": "naïve µ", "slot": None, "phi_xy": -0.0, "exit_code": 3},
+            {**_row("U3", 2), "time": "2026-03-01T09:00:00.000001+00:00", "sensor": None, "order": None},
+            {**_row("U4", 3), "time": datetime(2026, 3, 1, 9, 30), "phi_xy": math.inf, "scale_x": 1e-300}]
+    clean = [_clean(r) for r in rows]
+    assert _table(clean).equals(pa.Table.from_pylist(clean, schema=SCHEMA))
+    path = tmp_path / "results.parquet"
+    append_rows(path, rows)
+    back = pq.read_table(path)
+    assert back.column("time").to_pylist() == pa.Table.from_pylist(clean, schema=SCHEMA).column("time").to_pylist()
+    assert back.column("message").to_pylist()[1] == "naïve µ" and back.column("phi_xy").to_pylist()[3] is None
+    with pytest.raises(TypeError, match="column serial"):
+        _table([_clean({**_row("U5", 0), "serial": 5})])
+    with pytest.raises(TypeError, match="column order"):
+        _table([_clean({**_row("U5", 0), "order": 1.5})])
+
+
+def test_rows_read_back_as_pyarrow_reads_them(tmp_path):
+    from align.production.table import rows_of
+
+    path = tmp_path / "results.parquet"
+    append_rows(path, [_row("U1", 0), {**_row("U2", 1), "time": T0 + timedelta(microseconds=7)}])
+    table = read_table(path)
+    got, ref = rows_of(table), table.to_pylist()  # the times from the integers, not pyarrow's converter
+    assert [list(r) for r in got] == [list(r) for r in ref]
+    for a, b in zip(got, ref):
+        for k, v in b.items():
+            assert a[k] == v or (v is None and k in FIGURES and math.isnan(a[k])), k
+    assert got[1]["time"] == T0 + timedelta(microseconds=7) and got[1]["time"].utcoffset() == timedelta(0)
+
+
+def test_a_batch_parent_folding_its_journal_imports_no_pandas(tmp_path):
+    # pandas costs a batch a third of a second: pyarrow imports it for Python objects and the dataset reader
+    import subprocess
+    import sys
+
+    code = ("import sys\n"
+            "from datetime import datetime, UTC\n"
+            "from align.production import Journal, latest_rows, read_table\n"
+            "path = sys.argv[1] + '/results.parquet'\n"
+            "for run in ('r1', 'r2'):\n"
+            "    j = Journal(path)\n"
+            "    j.recover()\n"
+            "    latest_rows(read_table(path))\n"
+            "    j.add([{'serial': 'U1', 'order': 0, 'run': run, 'time': datetime.now(UTC), 'job': 'matrix',\n"
+            "            'status': 'ok', 'exit_code': 0, 'phi_xy': 0.001}])\n"
+            "    j.fold()\n"
+            "assert read_table(path).num_rows == 2 and len(latest_rows(read_table(path))) == 1\n"
+            "print('pandas' in sys.modules)\n")
+    got = subprocess.run([sys.executable, "-c", code, str(tmp_path)], capture_output=True, text=True, check=True)
+    assert got.stdout.strip() == "False"
