@@ -18,7 +18,7 @@ from support import ROOT
 MODULES = [
     "align.vocab",
     "align.io.source", "align.inspection", "align.io.noise_consumers", "align.io.dataflash", "align.io.dataflash_format",
-    "align.noise.periodic", "align.calibration.thermal.job", "align.calibration.thermal.model",
+    "align.noise.periodic", "align.calibration.thermal", "align.calibration.thermal.job", "align.calibration.thermal.model",
     "align.calibration.thermal.fit", "align.calibration.thermal.branches", "align.calibration.thermal.checks",
     "align.calibration.thermal.firmware", "align.calibration.thermal.simulate", "align.calibration.thermal.result",
     "align.job",

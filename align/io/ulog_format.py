@@ -55,7 +55,6 @@ _COMPILED: list = []
 _FIELD = re.compile(r"\s*([A-Za-z0-9_]+)\s*(?:\[\s*(\d+)\s*\])?\s+([A-Za-z0-9_]+)\s*")
 _LETTER = np.isin(np.arange(256), [*range(65, 91), *range(97, 123)])
 _D, _A, _R, _F, _O, _B = (ord(c) for c in "DARFOB")
-_DONTNEED = lambda mm: isinstance(mm, mmap.mmap) and hasattr(mmap, "MADV_DONTNEED")  # noqa: E731
 
 
 def sniff(head: bytes) -> bool:
@@ -263,8 +262,8 @@ class Scan:
                 bad = np.flatnonzero((size == 0) | ~_LETTER[kind])
                 k = int(bad[0]) if len(bad) else len(offs)
                 yield self._window(offs[:k], kind[:k], size[:k])
-                if (done := int(offs[0]) // mmap.PAGESIZE * mmap.PAGESIZE if k else 0) and _DONTNEED(mm):
-                    mm.madvise(mmap.MADV_DONTNEED, 0, done)  # the windows read: their pages go (bounded memory)
+                if (done := int(offs[0]) // mmap.PAGESIZE * mmap.PAGESIZE if k else 0) and isinstance(mm, mmap.mmap):
+                    mm.madvise(mmap.MADV_DONTNEED, 0, done)  # the windows read: their pages go (Linux; bounded memory)
                 if len(bad):
                     lost = int(offs[k])
                     found = mm.find(SYNC, lost, end)

@@ -191,11 +191,12 @@ class GlsFit:
         keep = self.signal_points
         if keep is None or keep.all() or keep.sum() < self.a.shape[1] + 2:
             return self
-        if getattr(self, "_sub", None) is None:
-            self._sub = GlsFit(self.a[keep], self.y[keep], self.basis[:, :, keep][:, :, :, keep], self.fallback[keep],
-                               self.scan)
-        self._sub.excess = self.excess
-        return self._sub
+        sub = self._sub
+        if sub is None:
+            sub = self._sub = GlsFit(self.a[keep], self.y[keep], self.basis[:, :, keep][:, :, :, keep],
+                                     self.fallback[keep], self.scan)
+        sub.excess = self.excess
+        return sub
 
     def select(self, p: np.ndarray, iterations: int) -> np.ndarray:
         """Holm's backward selection (module docstring) from the fit ``p``; the squared coefficients kept (J,).
