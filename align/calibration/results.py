@@ -10,7 +10,7 @@ it also writes the pair as imucal's JSON (:meth:`CalibrationSet.as_imucal`).
 
 Public names
 ------------
-Calibration, CalibrationSet, SENSORS, SENSOR_KEYS, FORMAT, CONVENTION, PLAIN_LEVEL
+Calibration, CalibrationSet, SENSORS, SENSOR_KEYS, FORMAT, CONVENTION, PLAIN_LEVEL, by_sensor
 """
 
 from __future__ import annotations
@@ -32,6 +32,15 @@ FORMAT = "imu-align.calibration"
 CONVENTION = "raw = M true + bias; true = M^-1 (raw - bias); rows of M are sensor axes"
 #: the sensors a calibration file may hold, in the order they are written
 SENSORS = ("accelerometer", "gyroscope")
+
+
+def by_sensor(sensors: dict, kinds: tuple[str, ...], what: str) -> dict:
+    """``sensors`` keyed by the sensor kinds ``kinds``, in their order; a result of ``what`` holding none of
+    them, or another kind, is refused (ValueError: a program's mistake, not a user's)."""
+    unknown = [k for k in sensors if k not in kinds]
+    if unknown or not sensors:
+        raise ValueError(f"{what} holds {' and/or '.join(kinds)}, not {unknown or 'nothing'}")
+    return {k: sensors[k] for k in kinds if k in sensors}
 #: the keys of one sensor's calibration in the file (unknown keys are refused: a misspelled key is not ignored)
 SENSOR_KEYS = ("sensor", "method", "convention", "units", "M", "A", "bias", "uncertainty", "residuals", "checks", "notes",
                "g_sensitivity", "rotations")
@@ -180,10 +189,7 @@ class CalibrationSet(Result, format=FORMAT, convention=CONVENTION):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        unknown = [k for k in self.sensors if k not in SENSORS]
-        if unknown or not self.sensors:
-            raise ValueError(f"a calibration set holds {' and/or '.join(SENSORS)}, not {unknown or 'nothing'}")
-        object.__setattr__(self, "sensors", {k: self.sensors[k] for k in SENSORS if k in self.sensors})
+        object.__setattr__(self, "sensors", by_sensor(self.sensors, SENSORS, "a calibration set"))
         object.__setattr__(self, "inputs", dict(self.inputs))
 
     def to_dict(self) -> dict:

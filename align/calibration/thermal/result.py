@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from align.calibration.results import by_sensor
 from align.calibration.thermal.branches import Hysteresis
 from align.calibration.thermal.model import AxisModel, ThermalModel
 from align.calibration.thermal.sensor import AxisReport, SensorThermal
@@ -113,10 +114,7 @@ class ThermalCalibration(Result, format=FORMAT, convention=CONVENTION):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        unknown = [k for k in self.sensors if k not in SENSORS]
-        if unknown or not self.sensors:
-            raise ValueError(f"a thermal calibration holds {' and/or '.join(SENSORS)}, not {unknown or 'nothing'}")
-        object.__setattr__(self, "sensors", {k: self.sensors[k] for k in SENSORS if k in self.sensors})
+        object.__setattr__(self, "sensors", by_sensor(self.sensors, SENSORS, "a thermal calibration"))
         object.__setattr__(self, "inputs", dict(self.inputs))
 
     def model(self, sensor: str | None = None, where: str = "thermal calibration") -> ThermalModel:
