@@ -55,11 +55,15 @@ def accel_files(result: CalibrationSet, inputs: AccelInputs, params: dict[str, A
         return []
     from align.calibration.accel import session_intervals
     from align.present.calplots import accel_statics_png
+    from align.present.reread import stated_gravity
+    from align.units import STANDARD_GRAVITY
 
     o = accel_options(**params)
     got = inputs.acc
     used = session_intervals(got.t, got.data, inputs.spec, o.detector, str(o.positions))
-    return [(Path(plot), accel_statics_png(got.t, got.data, used, got.shown))]
+    gravity = o.gravity if o.gravity is not None else stated_gravity(inputs.spec) or STANDARD_GRAVITY
+    return [(Path(plot), accel_statics_png(got.t, got.data, used, got.shown, calibration=result.sensor("accelerometer"),
+                                           gravity=gravity))]
 
 
 def accel(

@@ -41,6 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from align.model import angles
+from align.present.digits import with_sigma
 from align.units import DEG
 
 #: each row's definition, for a file's header or a report's note
@@ -87,17 +88,20 @@ class AngleRow:
     assumed: int | None = None
 
     def text(self, digits: int = 4) -> list[str]:
-        """Each element as ``x=+0.0123`` (``± 0.0004`` when known; ``(assumed)``); no negative zeros."""
+        """Each element as ``x=+0.0123`` (``± 0.0004`` when known, the value's decimals following it: ``± 0.0000042``
+        with 7, ``± 0`` for a 1-sigma of exactly zero; ``(assumed)``); no negative zeros."""
         sign = self.key not in ("scale", "psi")
         out = []
         for k, (n, v) in enumerate(zip(self.names, self.values)):
+            s = self.sigmas[k] if self.sigmas is not None and np.isfinite(self.sigmas[k]) else None
             if self.key == "scale":  # 6 decimals of a dimensionless M; 7 significant digits in counts
                 cell = number(v, 6, False) if self.unit == "1" else f"{v:.7g}"
-            else:
+                cell += "" if s is None else f" ± {s:.2g}"
+            elif s is None:
                 cell = f"{n}={number(v, digits, sign)}"
-            if self.sigmas is not None and np.isfinite(self.sigmas[k]):
-                s = self.sigmas[k]
-                cell += " ± " + (f"{s:.2g}" if self.key == "scale" else number(s, digits, False))
+            else:  # the angle to the decimal place its 1-sigma is shown to (never "± 0.0000")
+                value, sigma = with_sigma(v, s, digits, sign)
+                cell = f"{n}={value} ± {sigma}"
             out.append(cell + ("(assumed)" if k == self.assumed else ""))
         return out
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from align.errors import InputError
-from align.present.figures import COLOURS, display_unit, png_bytes, pyplot, trace
+from align.present.figures import COLOURS, display_unit, place_labels, png_bytes, pyplot, trace
 from align.units import DEG
 
 #: most points drawn of a scatter (a regular subsample beyond it)
@@ -33,12 +33,16 @@ def _series(t, x, what: str) -> tuple[np.ndarray, np.ndarray]:
     return t, x
 
 
-def accel_statics_png(t: np.ndarray, acc: np.ndarray, intervals: list, units: str) -> bytes:
+def accel_statics_png(t: np.ndarray, acc: np.ndarray, intervals: list, units: str, *, calibration=None,
+                      gravity: float | None = None) -> bytes:
     """The accelerometer's detected static intervals over time.
 
-    Top: the three axes in ``units``; bottom: ``|a|`` with each interval's mean ``|a|`` (a position whose
-    mean differs from the others' by much is not gravity alone). Every static interval is shaded and
-    numbered in both panels, in the order :func:`align.calibration.statics.static_intervals` found them.
+    Top: the three axes as read, in ``units``; bottom: ``|a|`` of the calibrated readings in m/s^2
+    (``M^-1 (a - b)`` of ``calibration``; the readings' own ``|a|`` in ``units`` when no calibration is given)
+    with each interval's mean (a position whose mean is off local gravity is not at rest or not gravity alone).
+    Every static interval is shaded in both panels and numbered, in the order
+    :func:`align.calibration.statics.static_intervals` found them (the numbers never overlap:
+    :func:`align.present.figures.place_labels`).
 
     Parameters
     ----------
@@ -50,6 +54,10 @@ def accel_statics_png(t: np.ndarray, acc: np.ndarray, intervals: list, units: st
         Static intervals as sample indices ``(start, stop)``, stop exclusive.
     units : str
         Display unit (``"m/s^2"``, ``"g"``, ``"counts"``, or a count size such as ``"16384 LSB/g"``).
+    calibration : Calibration, optional
+        The accelerometer's calibration (``correct`` maps the readings to m/s^2).
+    gravity : float, optional
+        Local gravity, m/s^2, drawn as a line with a calibration.
 
     Returns
     -------
@@ -69,13 +77,19 @@ def accel_statics_png(t: np.ndarray, acc: np.ndarray, intervals: list, units: st
             raise InputError(f"interval {a}..{b} lies outside the record's {n} samples", "static-interval picture")
     factor, shown = display_unit(units, ("acceleration",))
     shown_acc = acc / factor
-    norm = np.linalg.norm(shown_acc, axis=1)
+    if calibration is not None:
+        norm, norm_unit, what = np.linalg.norm(calibration.correct(acc), axis=1), "m/s^2", "|a| calibrated"
+    else:
+        norm, norm_unit, what = np.linalg.norm(shown_acc, axis=1), shown, "|a| as read (not calibrated)"
     plt = pyplot()
     fig, (ax, lg) = plt.subplots(2, 1, figsize=(11.0, 6.0), sharex=True, gridspec_kw={"height_ratios": [2.2, 1.3]})
     x, y = trace(t, np.column_stack([shown_acc, norm]))
     for j in range(3):
         ax.plot(x, y[:, j], color=COLOURS[j], lw=0.8, label=f"{'xyz'[j]} axis")
-    lg.plot(x, y[:, 3], color="0.25", lw=0.8, label="|a|")
+    lg.plot(x, y[:, 3], color="0.25", lw=0.8, label=what)
+    if calibration is not None and gravity is not None:
+        lg.axhline(gravity, color="tab:blue", lw=1.0, ls="--", label=f"local gravity {gravity:.5g} m/s^2")
+    mids = []
     for k, (a, b) in enumerate(spans):
         t0, t1 = float(t[a]), float(t[b - 1])
         for panel in (ax, lg):
@@ -83,17 +97,18 @@ def accel_statics_png(t: np.ndarray, acc: np.ndarray, intervals: list, units: st
         mean = float(norm[a:b].mean())
         lg.plot([t0, t1], [mean, mean], color="tab:orange", lw=2.2, zorder=5,
                 label="mean |a| of the interval" if k == 0 else None)
-        ax.annotate(str(k + 1), (0.5 * (t0 + t1), 1.0), xycoords=("data", "axes fraction"), ha="center", va="bottom",
-                    fontsize=8, color="#1f6f63")
+        mids.append(0.5 * (t0 + t1))
     if spans:
         means = np.array([norm[a:b].mean() for a, b in spans])
         spread = float(means.max() - means.min())
-        lg.set_title(f"|a| at rest: {means.min():.5g} to {means.max():.5g} {shown} over the intervals "
-                     f"(spread {spread:.3g} {shown})", fontsize=9)
+        off = "" if calibration is None or gravity is None else \
+            f", within {float(np.max(np.abs(means - gravity))):.3g} m/s^2 of gravity"
+        lg.set_title(f"{what} at rest: {means.min():.5g} to {means.max():.5g} {norm_unit} over the intervals "
+                     f"(spread {spread:.3g} {norm_unit}{off})", fontsize=9)
     ax.set_title(f"{len(spans)} static interval{'s' if len(spans) != 1 else ''} detected in {t[-1] - t[0]:.4g} s "
-                 f"({n:,} samples)", fontsize=10, pad=14)
+                 f"({n:,} samples), numbered; the readings as read", fontsize=10, pad=24)
     ax.set_ylabel(f"acceleration [{shown}]")
-    lg.set_ylabel(f"|a| [{shown}]")
+    lg.set_ylabel(f"|a| [{norm_unit}]")
     lg.set_xlabel("time [s]")
     lg.set_xlim(float(t[0]), float(t[-1]))
     for panel in (ax, lg):
@@ -102,6 +117,7 @@ def accel_statics_png(t: np.ndarray, acc: np.ndarray, intervals: list, units: st
                                                    if h.get_label() != "static interval"]
     fig.tight_layout(rect=(0, 0.05, 1, 1))
     fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8, frameon=False)
+    place_labels(ax, mids, [[str(k + 1) for k in range(len(spans))]], 1.0, "bottom", fontsize=8, color="#1f6f63")
     return png_bytes(fig)
 
 

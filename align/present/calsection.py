@@ -16,6 +16,7 @@ import numpy as np
 from align.errors import AlignError
 from align.present.angles import angle_rows
 from align.present.html import Section, angle_table, esc, image, table
+from align.present.residuals import ROTATION_RESIDUAL, is_scalar, largest, residual_values
 from align.units import DEG, to_unit
 
 _AXES = ("x", "y", "z")
@@ -40,6 +41,43 @@ def _inverse(unit: str) -> str:
     if unit.startswith("counts per "):
         return unit[len("counts per "):] + " per count"
     return unit
+
+
+def _rotation_table(cal) -> str:
+    """A gyro calibrated from rotations between poses: its rotation table, as ``calibrate gyro`` prints it."""
+    rows = []
+    for r in cal.rotations:
+        k, (t0, t1) = r["rotation"], r["t_s"]
+        rows.append([str(k), f"{k}->{k + 1}", f"{t0:.1f}-{t1:.1f}", f"{r['turn_deg']:.1f}",
+                     " ".join(f"{v:+.2f}" for v in r["axis"]), f"{r['residual_deg']:.3f}",
+                     "fit" if r["used"] else "left out: a check"])
+    return (f"<p>Rotations; residual: the {esc(ROTATION_RESIDUAL)}, in degrees:</p>"
+            + table(["rotation", "poses", "t [s]", "turn [deg]", "axis (accelerometer frame)", "residual [deg]", "use"],
+                    rows, left=0))
+
+
+def _residuals(cal) -> str:
+    """The residuals and held-out checks, then the largest residual, by :mod:`align.present.residuals` (the
+    terminal's figure and definition): a gyro's rotations in degrees, a scalar residual in one column."""
+    if cal.rotations:
+        body = _rotation_table(cal)
+    else:
+        body = ""
+        for what, pool in (("Residuals of the fit", cal.residuals), ("Held-out checks", cal.checks)):
+            if not pool:
+                continue
+            shown, unit = residual_values(dict(pool), cal.units)
+            if is_scalar(pool):  # one number per position (the |a| = g fit): one column
+                name = "|a| - g" if cal.sensor == "accelerometer" else "residual"
+                body += (f"<p>{what} ({esc(name)}, one number per position), {esc(unit)}:</p>"
+                         + table(["position", f"{name} [{unit}]"], [[k, f"{v[0]:+.4g}"] for k, v in shown.items()]))
+            else:
+                body += (f"<p>{what} (reading - model), {esc(unit)}:</p>"
+                         + table(["position", "x", "y", "z"], [[k] + [f"{x:+.4g}" for x in v] for k, v in shown.items()]))
+    for big in (largest(cal), largest(cal, held_out=True)):
+        if big is not None:
+            body += f"<p>{esc(big.text()[0].upper() + big.text()[1:])}.</p>"
+    return body
 
 
 def calibration_section(cal, source: str, picture: bytes | None = None, picture_note: str = "") -> Section:
@@ -74,11 +112,7 @@ def calibration_section(cal, source: str, picture: bytes | None = None, picture_
             + table(["", "x", "y", "z"], a_rows)
             + table([f"bias [{u}]", "x", "y", "z"], [["bias ± 1-sigma"] + bias])
             + angle_table(angle_rows(cal.M, cal.sigma_M, None, m_unit), cal.sensor))
-    for what, rows in (("Residuals of the fit (reading - model)", cal.residuals),
-                       ("Held-out checks (reading - model)", cal.checks)):
-        if rows:
-            body += f"<p>{what}, {esc(u)}:</p>" + table(["position", "x", "y", "z"],
-                                                          [[k] + _values(v, u, "+.4g") for k, v in rows.items()])
+    body += _residuals(cal)
     if cal.g_sensitivity is not None:  # as the calibration file and the terminal give it: the readings' unit per m/s^2
         kga, k_unit = np.array(d["g_sensitivity"], float), d["units"].get("g_sensitivity", "rad/s per m/s^2")
         body += (f"<p>g-sensitivity K_ga (<code>raw = M w + K_ga a + bias</code>), in {esc(k_unit)}:</p>"

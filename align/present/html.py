@@ -34,6 +34,13 @@ img{max-width:100%;border:1px solid #ddd;margin:.5em 0}code,pre{background:#f6f6
 .banner{font-size:1.15em;padding:.5em .8em;border:2px solid;border-radius:4px}.banner.pass{background:#eef8ee}
 .banner.fail{background:#fdeeee}.banner.info{background:#f2f5f8;border-color:#9ab}.banner.warn{background:#fdf6e8}
 table.header td{text-align:left;border:none;padding:.1em 1em .1em 0}table.header td:first-child{color:#555}
+table.fit{font-size:.9em;max-width:100%}table.fit td{white-space:nowrap}table.fit td.l{white-space:normal}
+td.wrap{overflow-wrap:anywhere;min-width:12em}
+@page{margin:12mm}
+@media print{body{max-width:none;margin:0;padding:0;font-size:10pt}table{font-size:8.5pt;max-width:100%}
+td,th{padding:.15em .35em;overflow-wrap:break-word}pre{white-space:pre-wrap;overflow-wrap:anywhere}
+tr,img{break-inside:avoid}h2{break-after:avoid}img{max-width:100%}
+.banner,th,.pass,.fail,.warn{-webkit-print-color-adjust:exact;print-color-adjust:exact}}
 """
 
 

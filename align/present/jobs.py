@@ -23,7 +23,7 @@ from align.io import LogFormat
 from align.present.html import Section
 from align.present.presets import preset_lines
 from align.present.reread import LOG_FIELDS, Said, in_words, read_capture, statics_picture, template
-from align.present.verdicts import FAIL, INFO, PASS, WARN, Verdict, worst
+from align.present.verdicts import FAIL, INFO, PASS, WARN, Verdict, checks_verdict, worst
 from align.units import DEG, DEG_H, parse_unit
 from align.units import parse_quantity as q
 
@@ -230,11 +230,8 @@ def alignment_job(rep: Report, allow, log: Path | None = None, plan: Path | None
                      + (f"; {n_mo} motion{'s' if n_mo != 1 else ''} that no step claimed, ignored" if n_mo else ""))
     if why:
         rep.lines.append(Said("  " + why))
-    warned = [c.name for c in r.checks if c.status == "warn"]
-    rep.verdicts.append(Verdict("alignment self-checks", WARN if warned else PASS,
-                                f"{counts.get('pass', 0)} of {len(r.checks)} pass", float(counts.get("pass", 0)),
-                                ("warnings: " + ", ".join(warned)) if warned else
-                                "durations, directions, scale, residuals as the alignment checks them"))
+    rep.verdicts.append(checks_verdict("alignment self-checks", r.checks,
+                                       "durations, directions, scale, residuals as the alignment checks them"))
     if allow is None:
         k = int(np.argmax(ang.psi))
         rep.verdicts.append(Verdict("measured misalignment", INFO, f"psi_{'xyz'[k]} {ang.psi[k] / DEG:.4f} deg",
@@ -246,7 +243,7 @@ def alignment_job(rep: Report, allow, log: Path | None = None, plan: Path | None
 
 def _measured(rep: Report, r, allow) -> None:
     """The measured misalignment propagated through the manoeuvre (the verdict), each element alone (the diagnosis)."""
-    from align.present.measured import describe, measured_margins, measured_section, output_margins
+    from align.present.measured import describe, headline, measured_margins, measured_section, output_margins
 
     outputs = output_margins(r.M, r.sigma_M, r.mounting, allow.manoeuvre)
     rows = measured_margins(r, allow)
@@ -255,8 +252,7 @@ def _measured(rep: Report, r, allow) -> None:
     rep.measured = rows
     rep.verdicts.append(Verdict("measured misalignment vs allowance", status,
                                 f"output {w.output} margin {w.margin / DEG:+.4f} deg", w.margin / DEG, detail))
-    rep.lines.append(f"measured vs allowance: {status} (output {w.output}: error {w.error / DEG:.4f} "
-                     f"± {w.sigma / DEG:.4f} deg, limit {w.limit / DEG:.4f} deg; guard band {w.k:g} sigma)")
+    rep.lines.append(f"measured vs allowance: {status} ({headline(w)})")
 
 
 def allan_job(rep: Report, allan: Path, columns: str | None = None, rate_hz: float | None = None,
@@ -330,6 +326,7 @@ def calibration_job(rep: Report, path: Path) -> None:
     from align.calibration.magnetometer import MagCalibration
     from align.calibration.results import CalibrationSet
     from align.present.calsection import calibration_section, magnetometer_section
+    from align.present.residuals import largest
     from align.results import load_result
     from align.vocab import Status
 
@@ -356,28 +353,13 @@ def calibration_job(rep: Report, path: Path) -> None:
     for kind, cal in res.sensors.items():
         png, why = statics_picture(Path(path), res.inputs, cal)
         rep.add("calibration", calibration_section(cal, str(path), png, in_words(why)))
-        pool = dict(cal.checks) or dict(cal.residuals)
-        what = "held-out check" if cal.checks else "residual"
-        worst_v = max((float(np.abs(v).max()) for v in pool.values()), default=float("nan"))
-        from align.present.figures import display_unit
-
-        factor, shown = display_unit(cal.units)
-        rep.verdicts.append(Verdict(f"{kind} calibration ({name})", Status.INFO,
-                                    f"largest {what} {worst_v / factor:.3g} {shown}", worst_v / factor,
-                                    f"{cal.method}; {_count(pool, cal.sensor)}"))
-        rep.lines.append(f"{kind} calibration {path}: {cal.method}, largest {what} {worst_v / factor:.3g} {shown}")
+        big = largest(cal, held_out=True) or largest(cal)  # the terminal's and the section's figure and definition
+        if big is not None:
+            rep.verdicts.append(Verdict(f"{kind} calibration ({name})", Status.INFO, big.number, big.value,
+                                        f"{cal.method}; {big.definition}; {big.count}"))
+            rep.lines.append(f"{kind} calibration {path}: {cal.method}, {big.number} ({big.where})")
         if why and png is None:
             rep.lines.append(Said("  " + why))
-
-
-def _count(pool: dict, sensor: str) -> str:  # a Sensor, or its value
-    """``10 attitudes``, ``6 rotations``: the residuals' own word (``attitude 1``) or the sensor's usual one."""
-    from align.vocab import Sensor
-
-    first = next(iter(pool), "")
-    word = first.split()[0] if " " in first and first.split()[-1].isdigit() else (
-        "rotation" if Sensor.parse(sensor) is Sensor.GYROSCOPE else "position")
-    return f"{len(pool)} {word}{'' if len(pool) == 1 else 's'}"
 
 
 def drift_job(rep: Report, path: Path) -> None:

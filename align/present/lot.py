@@ -7,13 +7,16 @@ are matplotlib PNGs embedded as data URIs (:func:`align.present.html.image`).
 
 Public names
 ------------
-batch_summary, lot_summary, lot_report_html, histograms_png, control_charts_png
+batch_summary, lot_summary, lot_report_html, histograms_png, control_charts_png, relative_paths
 """
 
 from __future__ import annotations
 
 import io
 import math
+import os
+import re
+from pathlib import Path
 
 import numpy as np
 
@@ -116,10 +119,38 @@ def lot_summary(stats, source: str) -> str:
     return "\n".join(lines)
 
 
-def _wide(html: str) -> str:
-    """A table kept within the page: scrolled sideways when wider, in a smaller type, cells not wrapped mid-value."""
-    return ('<div style="overflow-x:auto;max-width:100%;font-size:85%"><style>.lotw td{white-space:nowrap}</style>'
-            f'<div class="lotw">{html}</div></div>')
+def _fits(html: str) -> str:
+    """A table kept within the page, on screen and printed: no scroll box (a printed page would lose what it hides);
+    text cells wrap at blanks (a message's cells, class ``wrap``, anywhere), numbers do not (the page's style sheet,
+    :func:`align.present.html.html_report`, styles ``table.fit``)."""
+    return html.replace("<table>", '<table class="fit">', 1)
+
+
+#: an absolute path in a message: POSIX (``/home/...``) or Windows (``C:\\...``), up to a blank or punctuation
+_ABSOLUTE = re.compile(r"(?<![\w.~/:\\])(?:/|[A-Za-z]:\\)[^\s:;,()'\"<>]+")
+
+
+def relative_paths(message: str, folder: str | Path) -> str:
+    """``message`` with the absolute paths in it written relative to ``folder`` (``sessions/SN0003.csv`` for
+    ``/lots/7/sessions/SN0003.csv`` and ``/lots/7``; ``../in/SN0003.csv`` beside it); other text as it is.
+
+    Examples
+    --------
+    >>> relative_paths("error: /lots/7/sessions/SN3.csv: 3 rows with NaN; 100 deg/s", "/lots/7")
+    'error: sessions/SN3.csv: 3 rows with NaN; 100 deg/s'
+    >>> relative_paths("/data/in/SN3.csv: step 1 not found", "/lots/7")
+    '../../data/in/SN3.csv: step 1 not found'
+    """
+    base = os.path.abspath(str(folder))
+
+    def rel(m: re.Match) -> str:
+        path = m.group(0)
+        try:
+            return os.path.relpath(path, base)
+        except ValueError:  # another drive (Windows)
+            return path
+
+    return _ABSOLUTE.sub(rel, message.replace(base + os.sep, ""))
 
 
 def _grid(n: int):
@@ -213,11 +244,13 @@ def control_charts_png(stats, start: int = 0) -> bytes:
 
 
 def lot_report_html(stats, source: str) -> str:
-    """The lot's HTML report (one self-contained page)."""
+    """The lot's HTML report (one self-contained page): every column visible on screen and printed (no scroll box;
+    the statistics in two tables, the spread and the limits), paths in messages relative to the table's folder."""
     sections = []
     bad = [u for u in stats.units if u.verdict != "pass"]
     verdict = "pass" if not bad else "fail"
     lo, hi = stats.yield_interval
+    folder = Path(source).parent
     banner = (f'<p class="banner {verdict}">yield {stats.passed} of {stats.count} = {100 * stats.yield_:.1f} % '
               f"(95 % Wilson interval {100 * lo:.1f} to {100 * hi:.1f} %): "
               + ("every unit passes" if not bad else f"{len(bad)} units do not pass") + "</p>")
@@ -226,15 +259,22 @@ def lot_report_html(stats, source: str) -> str:
                             "units that failed, gave an error or have a limit not checked count as not passing. Spec: "
                             + esc(stats.spec.path if stats.spec else "none") + ".</p>" + notes))
     if bad:
-        rows = [[u.serial, u.job, (u.verdict, "fail"), "; ".join(u.reasons)] for u in bad]
+        rows = [[u.serial, u.job, (u.verdict, "fail"), (relative_paths("; ".join(u.reasons), folder), "wrap")]
+                for u in bad]
         sections.append(Section(f"Units not passing ({len(bad)})",
-                                _wide(table(["serial", "jobs", "verdict", "why"], rows, 4))))
+                                _fits(table(["serial", "jobs", "verdict", "why"], rows, 4))
+                                + f'<p class="note">Paths relative to the folder of the table, '
+                                  f"<code>{esc(folder)}</code>.</p>"))
     if stats.figures:
-        header = _HEADER + [f"trend {_per(stats)}"]
-        sections.append(Section("Statistics", _wide(table(header, _stats_rows(stats), 5)) + '<p class="note">Mean, '
-                                "std, min, max and trend in each figure's unit; Cpk &plusmn; its standard error; "
-                                "outliers by the robust z-score (beyond 3.5, from 8 units on); * a trend beyond 3 "
-                                "sigma. Each job, sensor and unit (counts or SI) is its own population.</p>"))
+        rows = _stats_rows(stats)
+        spread = [r[:3] + r[4:10] for r in rows]  # figure, sensor, job, unit, n, mean, std, min, max
+        limits = [r[:4] + r[10:] for r in rows]  # figure, sensor, job, limit, Cpk, yield, outliers, trend
+        sections.append(Section("Statistics", _fits(table(_HEADER[:3] + _HEADER[4:10], spread, 4))
+                                + _fits(table(_HEADER[:4] + _HEADER[10:] + [f"trend {_per(stats)}"], limits, 4))
+                                + '<p class="note">Mean, std, min, max and trend in each figure\'s unit; Cpk &plusmn; '
+                                "its standard error; outliers by the robust z-score (beyond 3.5, from 8 units on); * a "
+                                "trend beyond 3 sigma. Each job, sensor and unit (counts or SI) is its own "
+                                "population.</p>"))
         starts = range(0, len(stats.figures), MAX_PANELS)
         sections.append(Section("Histograms", "".join(
             image(histograms_png(stats, k), "histogram of each figure with its limits") for k in starts)

@@ -19,7 +19,7 @@ the allowance up; it does not decide the verdict, since errors from several elem
 Public names
 ------------
 GUARD_K, guard, worst_status, OutputMargin, MeasuredMargin, output_margins, measured_margins, measured_section,
-describe
+describe, headline
 """
 
 from __future__ import annotations
@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from align.present.digits import ratio_text, with_sigma
 from align.present.html import Section, table
 from align.present.verdicts import FAIL, PASS, WARN, angle_sigmas
 from align.sensitivity.symbolic import ELEMENTS
@@ -200,28 +201,36 @@ def _cls(status: str) -> str:
     return classes.get(status, "")
 
 
-def _s(x: float) -> str:
-    return f"{x / DEG:.4f}" if np.isfinite(x) else "-"
+def _deg(value: float, sigma: float, sign: bool = False) -> tuple[str, str]:
+    """An angle (rad) and its 1-sigma in degrees, the digits following the 1-sigma (:mod:`align.present.digits`)."""
+    return with_sigma(value / DEG, sigma / DEG, 4, sign)
 
 
-def _ratio(x: float) -> str:
-    return f"{x:+.1f}" if np.isfinite(x) else "-"
+def _given(x: float) -> str:
+    """A limit or an allowance (a requirement, not a measurement), degrees to 4 decimals."""
+    return f"{x / DEG:.4f}"
 
 
 def measured_section(outputs: list[OutputMargin], rows: list[MeasuredMargin], k: float = GUARD_K) -> Section:
     """The verdict table (each limited output) and the diagnosis table (each element alone)."""
     status = worst_status(o.status for o in outputs)
-    out_rows = [[o.output, f"{o.error / DEG:.4f}", _s(o.sigma), f"{o.limit / DEG:.4f}", f"{o.margin / DEG:+.4f}",
-                 _ratio(o.sigmas), (o.status, _cls(o.status))] for o in outputs]
+    out_rows = []
+    for o in outputs:
+        error, sigma = _deg(o.error, o.sigma)
+        out_rows.append([o.output, error, sigma, _given(o.limit), _deg(o.margin, o.sigma, True)[0],
+                         ratio_text(o.margin, o.sigma), (o.status, _cls(o.status))])
     el_rows = []
     for r in rows:
         bounded = np.isfinite(r.allowed)
-        sign = "+" if r.element.startswith("phi") else ""  # phi_ij is signed, psi_i an angle from the axis
-        el_rows.append([r.element, f"{r.measured / DEG:{sign}.4f}", _s(r.sigma),
-                        f"{r.allowed / DEG:.4f}" if bounded else "unconstrained",
-                        f"{r.margin / DEG:+.4f}" if bounded else "-", _ratio(r.sigmas), (r.status, _cls(r.status))])
+        sign = r.element.startswith("phi")  # phi_ij is signed, psi_i an angle from the axis
+        measured, sigma = _deg(r.measured, r.sigma, sign)
+        el_rows.append([r.element, measured, sigma, _given(r.allowed) if bounded else "unconstrained",
+                        _deg(r.margin, r.sigma, True)[0] if bounded else "-",
+                        ratio_text(r.margin, r.sigma) if bounded else "-", (r.status, _cls(r.status))])
     band = (f"Guard band k = {k:g}: PASS when the margin exceeds {k:g} sigma, FAIL when it is below -{k:g} sigma, WARN "
-            f"when it is within {k:g} sigma of the limit (the measurement cannot tell).")
+            f"when it is within {k:g} sigma of the limit (the measurement cannot tell). Each value is shown to the decimal "
+            "place of its 1-sigma; margin / sigma to two digits, \"> +1000\" beyond a thousand, and not at all "
+            "against a 1-sigma of 0.")
     body = (f"<p>Measured misalignment propagated through the manoeuvre: <b class=\"{_cls(status)}\">{status}</b>. "
             "The gyro axes' measured directions relative to the nominal mounting (<code>M N<sup>T</sup></code>, rows "
             "scaled to unit length: scale-factor errors are left out) turn the manoeuvre's rotations by attitude "
@@ -246,11 +255,26 @@ def describe(outputs: list[OutputMargin], rows: list[MeasuredMargin]) -> tuple[S
     w = min(outputs, key=lambda o: o.margin)
     bounded = [r for r in rows if np.isfinite(r.allowed)]
     near = min(bounded, key=lambda r: r.margin) if bounded else None
-    detail = (f"output {w.output}: error {w.error / DEG:.4f} ± {_s(w.sigma)} deg against the {w.limit / DEG:.4f} deg "
+    error, sigma = _deg(w.error, w.sigma)
+    detail = (f"output {w.output}: error {error} ± {sigma} deg against the {_given(w.limit)} deg "
               f"limit (the measured misalignment propagated through the manoeuvre; guard band {w.k:g} sigma)"
               + ("" if near is None else f"; element nearest its allowance alone: {near.element} "
-                 f"{near.measured / DEG:+.4f} deg of {near.allowed / DEG:.4f} deg"))
+                 f"{_deg(near.measured, near.sigma, True)[0]} deg of {_given(near.allowed)} deg"))
     over = [o.output for o in outputs if o.status == FAIL]
     if over:
         detail += "; over the limit: " + ", ".join(over)
     return status, w, detail
+
+
+def headline(w: OutputMargin) -> str:
+    """The terminal's line for the binding output, its digits following its 1-sigma
+    (``output y: error 0.1559 ± 0.0004 deg, limit 1.0000 deg, margin +0.8441 deg; guard band 2 sigma``).
+
+    Examples
+    --------
+    >>> headline(OutputMargin("z", 0.0015 * DEG, 4.2e-6 * DEG, 1.0 * DEG))
+    'output z: error 0.0015000 ± 0.0000042 deg, limit 1.0000 deg, margin +0.9985000 deg; guard band 2 sigma'
+    """
+    error, sigma = _deg(w.error, w.sigma)
+    return (f"output {w.output}: error {error} ± {sigma} deg, limit {_given(w.limit)} deg, margin "
+            f"{_deg(w.margin, w.sigma, True)[0]} deg; guard band {w.k:g} sigma")

@@ -9,6 +9,7 @@ allan_plot_png, allan_ylim, segmentation_plot_png, segmentation_spans, Span
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -22,17 +23,76 @@ from align.units import to_unit
 _TERM_STYLES = (":", "-.", ":", "-.", ":")
 
 
-def _term_label_at(y: np.ndarray, lo: float, hi: float, falling: bool, j: int) -> int | None:
-    """Index of the tau where a term's asymptote is labelled (None when it never enters [lo, hi]): a flat or
-    rising line at its last point inside (the right edge), a falling one near the bottom, a little higher
-    for each channel ``j`` so that the labels of neighbouring lines do not overlap."""
+def _term_label_at(y: np.ndarray, lo: float, hi: float, falling: bool) -> int | None:
+    """Index of the tau where a term's asymptote is labelled first (None when it never enters [lo, hi]): a flat or
+    rising line at its last point inside (the right edge), a falling one near the bottom."""
     inside = np.flatnonzero((y >= lo) & (y <= hi))
     if not len(inside):
         return None
     if not falling:
         return int(inside[-1])
-    level = lo * 1.4 * (hi / lo) ** (0.05 * j)
-    return int(inside[np.argmin(np.abs(np.log(y[inside] / level)))])
+    return int(inside[np.argmin(np.abs(np.log(y[inside] / (lo * 1.4))))])
+
+
+@dataclass(frozen=True)
+class _TermLabel:
+    """One asymptote's label: its term symbol, the channels it names, its colour and where it may go."""
+
+    symbol: str
+    channels: tuple[str, ...]
+    colour: object
+    tau: np.ndarray
+    y: np.ndarray
+    first: int
+
+    @property
+    def text(self) -> str:
+        return f" {' '.join(self.channels)} {self.symbol}"
+
+
+def _term_labels(found: list[tuple]) -> list[_TermLabel]:
+    """The labels of the asymptotes drawn, ``found`` as ``(symbol, channel, colour, tau, y, first)``: the channels'
+    lines of one term that lie within 30 % of each other where labelled share one label (``x y z N``, dark grey)."""
+    out: list[_TermLabel] = []
+    for symbol in dict.fromkeys(f[0] for f in found):
+        rest = sorted((f for f in found if f[0] == symbol), key=lambda f: float(f[4][f[5]]))
+        while rest:
+            head, rest = rest[0], rest[1:]
+            level = float(head[4][head[5]])
+            near = [f for f in rest if abs(np.log(float(f[4][head[5]]) / level)) < np.log(1.3)]
+            rest = [f for f in rest if all(f is not g for g in near)]
+            group = sorted([head, *near], key=lambda g: next(i for i, f in enumerate(found) if f is g))
+            out.append(_TermLabel(symbol, tuple(g[1] for g in group), head[2] if len(group) == 1 else "0.15",
+                                  head[3], head[4], head[5]))  # on the lowest line of the group
+    return out
+
+
+def _place_term_labels(ax, labels: list[_TermLabel], lo: float, hi: float) -> list:
+    """Each label on its line, at the first point (from where :func:`_term_label_at` puts it, then along the line
+    toward shorter tau) where it overlaps no label placed before, the legend nor the axes' edges."""
+    from align.present.figures import overlapping, text_boxes
+
+    renderer = ax.figure.canvas.get_renderer()
+    frame = ax.get_window_extent(renderer)
+    legend = ax.get_legend()
+    keep_out = [] if legend is None else [legend.get_window_extent(renderer)]
+    placed: list = []
+    for lab in labels:
+        inside = [i for i in range(lab.first, -1, -1) if lo <= lab.y[i] <= hi]
+        text = None
+        for i in inside[::max(1, len(inside) // 40)]:
+            if text is not None:
+                text.remove()
+            text = ax.text(lab.tau[i], float(lab.y[i]), lab.text, fontsize=7, color=lab.colour, va="center",
+                           bbox={"boxstyle": "square,pad=0.1", "fc": "white", "alpha": 0.75, "lw": 0})
+            (box,) = text_boxes([text], renderer, 1.0)
+            clear = (frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1
+                     and not any(box.overlaps(k) for k in keep_out))
+            if clear and not overlapping(placed + [text], renderer, gap=2.0):
+                break
+        if text is not None:
+            placed.append(text)
+    return placed
 
 
 def _short_names(names: tuple) -> list[str]:
@@ -64,7 +124,8 @@ def allan_plot_png(job: AllanJob, target: float | None = None, chosen_tau: float
     With several runs each run's curve is drawn thin and the pooled curve (the one fitted) bold. The
     y range comes from the curves and their 68 % intervals (and the target); the single-term
     asymptotes of the identifiable terms only are drawn, each labelled with its channel and IEEE
-    letter (``x N``, ``x B``, ...).
+    letter (``x N``, ``x B``, ...; one label ``x y z N`` for the channels' lines of a term that lie within
+    30 % of each other), each label on its line where it overlaps no other label nor the legend.
 
     Parameters
     ----------
@@ -92,6 +153,7 @@ def allan_plot_png(job: AllanJob, target: float | None = None, chosen_tau: float
             ax.loglog(rr.tau, to_unit(rr.adev[j], shown), color=COLOURS[j % len(COLOURS)], lw=0.7, alpha=0.7, ls=style)
         name = Path(job.inputs[k]).name if k < len(job.inputs) else ""
         ax.plot([], [], color="0.4", lw=0.7, ls=style, label=f"run {k + 1} {name}".rstrip())
+    found: list = []  # the asymptotes drawn, labelled once the figure is laid out
     for j, (name, short, f) in enumerate(zip(r.names, _short_names(r.names), job.fits)):
         c = COLOURS[j % len(COLOURS)]
         ax.loglog(r.tau, to_unit(r.adev[j], shown), color=c, lw=2.2 if job.pooled else 1.5,
@@ -103,9 +165,9 @@ def allan_plot_png(job: AllanJob, target: float | None = None, chosen_tau: float
                 continue
             y = to_unit(f.model.only(t.key)(r.tau), shown)
             ax.loglog(r.tau, y, color=c, lw=0.8, ls=_TERM_STYLES[k], alpha=0.8)
-            at = _term_label_at(y, lo, hi, t.alpha > 0 or t.key == "white", j)
+            at = _term_label_at(y, lo, hi, t.alpha > 0 or t.key == "white")
             if at is not None:
-                ax.text(r.tau[at], float(y[at]), f" {short} {t.symbol}", fontsize=7, color=c, va="center")
+                found.append((t.symbol, short, c, np.asarray(r.tau, float), np.asarray(y, float), at))
     if target is not None:
         ax.axhline(level, color="k", lw=1, ls="--", label=f"noise target {level:.4g} {shown}")
     if chosen_tau is not None:
@@ -118,6 +180,7 @@ def allan_plot_png(job: AllanJob, target: float | None = None, chosen_tau: float
                  "dotted/dash-dot: identified terms, labelled channel and IEEE letter)", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
+    _place_term_labels(ax, _term_labels(found), lo, hi)
     return png_bytes(fig)
 
 

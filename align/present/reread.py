@@ -11,7 +11,7 @@ words on the page: :func:`in_words`).
 Public names
 ------------
 recorded_format, resolve_recorded, template, in_words, Said, reread_alignment_log, read_capture, statics_picture,
-LOG_FIELDS
+stated_gravity, LOG_FIELDS
 """
 
 from __future__ import annotations
@@ -127,6 +127,25 @@ def read_capture(result_path: Path, inputs: dict, columns: str, units_key: str, 
         return None, None, f"no picture: the capture {literal(log)} could not be read again ({template(exc, words=True)})"
 
 
+def stated_gravity(spec: dict | None) -> float | None:
+    """Local gravity, m/s^2, as a positions file (``spec``, read) states it; None when it states none (or none is
+    given) or states it wrongly (the calibration refused that already).
+
+    Examples
+    --------
+    >>> stated_gravity({"gravity": "9.81 m/s^2"}), stated_gravity(None)
+    (9.81, None)
+    """
+    from align.units import parse_quantity
+
+    if not spec or "gravity" not in spec:
+        return None
+    try:
+        return parse_quantity(spec["gravity"], "acceleration", "gravity")
+    except AlignError:
+        return None
+
+
 def statics_picture(result_path: Path, inputs: dict, cal):
     """The static intervals of an accelerometer session, detected again from the log the calibration names;
     ``(png or None, note template)``."""
@@ -154,4 +173,4 @@ def statics_picture(result_path: Path, inputs: dict, cal):
     except AlignError as exc:
         return None, f"no picture: the session's intervals could not be found again ({template(exc, words=True)})"
     note = "" if det else "static intervals detected again with the default detector settings (the file records none)"
-    return accel_statics_png(got.t, got.data, iv, cal.units), note
+    return accel_statics_png(got.t, got.data, iv, cal.units, calibration=cal, gravity=stated_gravity(spec)), note

@@ -248,24 +248,10 @@ def _say(line, spell) -> str:
 
 
 def _verdict(verdicts) -> str:
-    """The terminal's last line: FAIL (the failed checks), WARN (the cautions), PASS, or no requirement checked;
-    and a failed design check that governs nothing."""
-    from align.present.verdicts import FAIL, PASS, WARN
+    """The terminal's last line (:func:`align.present.verdicts.summary_line`: what the page's banner says)."""
+    from align.present.verdicts import summary_line
 
-    governing = [v for v in verdicts if v.governs]
-    failed = [v for v in governing if v.status == FAIL]
-    warned = [v for v in governing if v.status == WARN]
-    if failed:
-        out = "FAIL (" + "; ".join(f"{v.check}: {v.number}" for v in failed) + ")"
-    elif warned:
-        out = "WARN (" + "; ".join(f"{v.check}: {v.number}" for v in warned) + ")"
-    else:
-        out = "PASS" if any(v.status == PASS for v in governing) else "no requirement checked"
-    design = [v for v in verdicts if not v.governs and v.status == FAIL]
-    if design:
-        out += "; design check " + ", ".join(f"{v.check} FAIL ({v.number})" for v in design) + \
-            ": the measured unit governs"
-    return out
+    return summary_line(verdicts)
 
 
 def build_report(mount: Path | None = None, manoeuvre: Path | None = None, **kwargs) -> tuple[str, str, dict]:

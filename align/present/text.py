@@ -19,7 +19,9 @@ import numpy as np
 
 from align.alignment.result import AlignmentResult
 from align.present.angles import AngleRow, angle_rows, number
+from align.present.digits import with_sigma
 from align.present.presets import preset_lines
+from align.present.residuals import held_out_rows, largest
 from align.units import DEG, to_unit
 
 if TYPE_CHECKING:
@@ -306,21 +308,11 @@ def calibration_summary(cals: dict) -> str:
             out.append(matrix_text(np.array(d["g_sensitivity"]), None, 6, "    "))
         out += ["  angles of M's rows (sensor axes) in the calibration frame [deg]:",
                 *angle_lines(angle_rows(c.M, c.sigma_M, unit=mu), "    ")]
-        used = [r for r in getattr(c, "rotations", None) or () if r.get("used", True)]
-        if used:  # calibrate gyro: the angle the rotation table and the note show
-            big = max(used, key=lambda r: r["residual_deg"])
-            out.append(f"  largest residual: rotation {big['rotation']}, {big['residual_deg']:.3g} deg (angle between "
-                       f"the predicted and the measured gravity direction; {len(used)} rotations)")
-        elif d["residuals"]:
-            worst = max(d["residuals"].items(), key=lambda kv: float(np.max(np.abs(kv[1]))))
-            n = len(d["residuals"])
-            what = (f"{n} rotations" if all(k.startswith("rotation ") for k in d["residuals"]) else
-                    f"{n} poses" if all(k.startswith("attitude ") for k in d["residuals"]) else f"{n} positions")
-            if c.sensor == "gyroscope" and "turn" in c.method.lower() and not what.endswith("rotations"):
-                what = f"the {n} static faces, where the bias is fitted; M is fitted from the turns"
-            out.append(f"  largest residual: {worst[0]} {np.max(np.abs(worst[1])):.3g} {u} ({what})")
-        for k, v in d["checks"].items():
-            out.append(f"  held-out check {k}: residual {np.max(np.abs(v)):.3g} {u}")
+        big = largest(c)  # the one figure and definition of the report and the picture
+        if big is not None:
+            out.append("  " + big.text())
+        for where, value, unit in held_out_rows(c):
+            out.append(f"  held-out check {where}: residual {value:.3g} {unit}")
         out += [f"  note: {n}" for n in d["notes"]] + [""]
     return "\n".join(out).rstrip()
 
@@ -336,7 +328,7 @@ def magnetometer_summary(c) -> str:
     rot = d.get("misalignment_angles")
     rot_lines = [] if rot is None else [
         "  misalignment rotation (alpha, beta, gamma about x, y, z) [deg]: "
-        + ", ".join(number(a, 3) + ("" if s is None else f" ± {s:.3f}")
+        + ", ".join(number(a, 3) if s is None else " ± ".join(with_sigma(a, s, 3, True))
                     for a, s in zip(rot["angles_deg"], rot["sigma_deg"] or [None] * 3))
         + ("" if rot["sigma_deg"] is None else " (1 sigma)")]
     lines = [f"magnetometer ({d['model']} soft iron), convention {d['convention']}",

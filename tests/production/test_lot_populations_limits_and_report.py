@@ -203,7 +203,7 @@ def test_the_report_draws_every_figure_keeps_tables_in_the_page_and_no_spec_lege
     html = lot_report_html(stats, "t.parquet")
     pictures = 2 * math.ceil(n / MAX_PANELS)  # histograms and control charts, every figure
     assert html.count("data:image/png;base64,") == pictures and f"All {n} figures" in html
-    assert 'overflow-x:auto' in html.split("Statistics")[1]
+    assert 'overflow-x' not in html and html.split("Statistics")[1].count('<table class="fit">') == 2
     fig, ax = plt.subplots()
     _legend(ax, stats.figures[0], False, ("mean", "k", "-"))
     assert "outside the spec" not in [t.get_text() for t in ax.get_legend().get_texts()]
