@@ -158,7 +158,7 @@ def _detect(step: float) -> list[str]:
 
 
 def time_unit(step: float, column: str, where: str, given: str | None = None,
-              first: float | None = None) -> tuple[str, bool]:
+              first: float | None = None, *, stated: bool = False) -> tuple[str, bool]:
     """The unit of a time column from its median step, or the given unit checked against it.
 
     Parameters
@@ -212,7 +212,8 @@ def time_unit(step: float, column: str, where: str, given: str | None = None,
         return found, True
     if _in_band(step, given):
         return given, False
-    fix = (f"the step suggests {{time_units={found}}}" if found is not None and found != given
+    fix = (f"the step suggests {{time_units={found}}}" if found is not None and found != given and not stated
+           else "it is the log's own time (its unit stated): read another stream ({topic})" if stated
            else "check the time column ({columns}), or read the log without it ({rate_hz})")
     raise InputError(f"{name} in {given}: its median step {step:.4g} {given} is {_rate(step, given):.3g} Hz, not an "
                      f"IMU sample rate ({band}); {fix}", where)

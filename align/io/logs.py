@@ -117,11 +117,12 @@ class SensorLog:
         return f"time column read in {self.time_units} ({how}: {self.rate_hz:.6g} Hz)"
 
 
-def _time_of(raw: np.ndarray, column: str, where: str, fmt: LogFormat) -> tuple[np.ndarray, str, bool]:
-    """Time in s from a time column's numbers; its unit detected or given (:func:`~align.io.formats.time_unit`)."""
+def _time_of(raw: np.ndarray, column: str, where: str, fmt: LogFormat, stated: bool = False) -> tuple[np.ndarray, str, bool]:
+    """Time in s from a time column's numbers; its unit detected, given or ``stated`` (:func:`~align.io.formats.time_unit`)."""
     check_repeats(raw, where)  # before the step is judged: a coarse clock's median step means nothing
     step = float(np.median(np.diff(raw))) if len(raw) > 1 else float("nan")
-    unit, detected = time_unit(step, column, where, fmt.time_units, float(raw[0]) if len(raw) else None)
+    unit, detected = time_unit(step, column, where, fmt.time_units, float(raw[0]) if len(raw) else None,
+                               stated=stated)
     return (raw * TIME_UNITS[unit] if unit != "s" else raw), unit, detected
 
 
@@ -206,7 +207,7 @@ def read_sensor_log(path: str | Path, columns: list[str], units: str | None, tim
     if time_col is not None:
         raw_t, values = data[:, 0], data[:, 1:]
         check_readings(values, str(path), raw_t)
-        t, tu, detected = _time_of(raw_t, time_col, str(path), fmt_time)
+        t, tu, detected = _time_of(raw_t, time_col, str(path), fmt_time, stated=fmt_time is not fmt)
         step = float(np.median(np.diff(t))) if len(t) > 1 else float("nan")
         fs = 1.0 / step if step > 0 else float("nan")
     else:
@@ -402,8 +403,9 @@ def read_static_log(log: str | Path, names: list[str], rate_hz: float | None, lo
         return StaticLog(values * scale if scale != 1 else values, float(rate_hz), None, False, step, *stated)
     check_readings(data[:, 1:], str(log), data[:, 0])
     said = got.units.get(time_column)
-    t, unit, detected = _time_of(data[:, 0], time_column, str(log),
-                                 replace(fmt, time_units=said) if fmt.time_units is None and said in TIME_UNITS else fmt)
+    stated_time = fmt.time_units is None and said in TIME_UNITS
+    t, unit, detected = _time_of(data[:, 0], time_column, str(log), replace(fmt, time_units=said) if stated_time else fmt,
+                                 stated=stated_time)
     check_log(t, data[:, 1:], str(log), min_rows=3)
     check_time(t, str(log), gap=1.5, jitter=True)  # an Allan deviation needs uniform samples
     values = np.ascontiguousarray(data[:, 1:])

@@ -163,13 +163,14 @@ def all_readers() -> list[LogReader]:
 
 
 def _load(names) -> None:
-    """Import the plugin modules ``names`` not imported yet and register their ``READER``."""
+    """Register the ``READER`` of each plugin module of ``names`` that the registry lacks (a module imported
+    before is not imported again: ``sys.modules``)."""
     import importlib
 
     for name in names:
-        if name not in _LOADED:
-            _LOADED.add(name)
-            register(importlib.import_module(name).READER)
+        reader = importlib.import_module(name).READER
+        if not any(r is reader for r in READERS):
+            register(reader)
 
 
 def reader_for(path: Path, log_format: LogFormat | None = None) -> LogReader:
@@ -242,7 +243,6 @@ def _builtin() -> None:
 #: imports them: the command line's start-up stays as it was)
 PLUGINS: dict[str, tuple[str, ...]] = {"align.io.ulog": (".ulg",), "align.io.dataflash": (".bin",),
                                        "align.io.rosbag": (".bag", ".db3", ".mcap"), "align.io.euroc": ()}
-_LOADED: set[str] = set()
 
 
 _builtin()

@@ -109,12 +109,10 @@ def write_bag(folder, kind: str, topics, typestore=None):
 @pytest.fixture(autouse=True)
 def registered():
     """The rosbag reader registered for these tests (the registry restored after each)."""
-    saved, loaded = list(readers.READERS), set(readers._LOADED)
+    saved = list(readers.READERS)
     readers.register(rosbag.READER)
     yield
     readers.READERS[:] = saved
-    readers._LOADED.clear()
-    readers._LOADED.update(loaded)
 
 
 @pytest.fixture(scope="module")

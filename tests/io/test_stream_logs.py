@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from support import SHARED
 
 from align.errors import InputError
 from align.io import readers
@@ -314,3 +315,15 @@ def test_a_magnetometer_stream_is_calibrated_in_the_unit_it_states(tmp_path, fak
     with pytest.raises(InputError) as err:
         calibrate_mag(log=log, units="uT")
     assert "mag_units" in err.value.fields and "gauss" in err.value.message
+
+
+def test_a_stream_at_a_rate_no_job_takes_points_to_another_stream_not_to_a_time_unit():
+    """The real ULog's sensor_gyro:1 is logged at 1 Hz: its time unit is the log's own (stated), so the refusal
+    names --topic, never --time-units (which a ULog does not take)."""
+    from align.io.formats import LogFormat
+    from align.io.logs import read_static_log
+
+    ulog = SHARED / "data" / "logs" / "px4_ulog" / "sample_log_small.ulg"
+    with pytest.raises(InputError) as exc:
+        read_static_log(ulog, ["gyro_x", "gyro_y", "gyro_z"], None, LogFormat(topic="sensor_gyro:1"))
+    assert "{topic}" in exc.value.message and "time_units" not in exc.value.message
