@@ -2,10 +2,12 @@
 
 Public names
 ------------
-require_finite, array_field, malformed
+require_finite, array_field, malformed, check_inverse, INVERSE_TOLERANCE
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -56,3 +58,21 @@ def malformed(exc: Exception) -> str:
     if isinstance(exc, KeyError):
         return f"missing key {literal(repr(exc.args[0]) if exc.args else '')}"
     return literal(" ".join(str(exc).split()) or type(exc).__name__)
+
+
+#: the largest |A M - I| of a result's A and M: about ten steps of a float (2^-23) at 1, below what a C header's float
+#: literals resolve; a larger one is a hand-edited file
+INVERSE_TOLERANCE = 1e-6
+
+
+def check_inverse(m, a, where: str, field: str) -> None:
+    """Refuse an ``A`` that is not ``M^-1`` beyond :data:`INVERSE_TOLERANCE` (an ``M`` that is singular, left-handed
+    or not finite is left to the checks that name ``M``: :func:`align.plausible.check_usable_model`)."""
+    m, a = np.asarray(m, dtype=float), np.asarray(a, dtype=float)
+    if m.shape != (3, 3) or a.shape != (3, 3) or not (np.all(np.isfinite(m)) and np.linalg.det(m) > 1e-12):
+        return
+    err = float(np.max(np.abs(a @ m - np.eye(3)))) if np.all(np.isfinite(a)) else math.inf
+    if not err <= INVERSE_TOLERANCE:
+        raise InputError(f"is not the inverse of {field}M (largest |A M - I| = {err:.2g}, more than "
+                         f"{INVERSE_TOLERANCE:g}): the file was edited; restore A = M^-1 or regenerate the result",
+                         f"{where}: {field}A")

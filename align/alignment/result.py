@@ -22,7 +22,7 @@ from align.model import Angles, SensorModel, angles
 from align.results import Result, file_unit
 from align.units import DEG, parse_unit, to_unit
 from align.values import Value
-from align.wellformed import array_field, malformed
+from align.wellformed import array_field, check_inverse, malformed
 
 FORMAT = "imu-align.alignment"
 FORMAT_VERSION = 1
@@ -173,6 +173,7 @@ class AlignmentResult(Result, format=FORMAT, version=FORMAT_VERSION, convention=
             )
             inferred = d.get("inferred_axis")
             a = array_field(d, "A", (3, 3), "alignment result", where)
+            check_inverse(m, a, where, "")  # a hand-edited A is refused where it is read, for every command
             bias = array_field(d, "bias", (3,), "alignment result", where, f)
             return cls(
                 method=d["method"], M=m, A=a, bias=bias,

@@ -26,7 +26,7 @@ from align.plausible import check_usable_model
 from align.results import Result, file_unit
 from align.units import to_unit
 from align.values import Value, frozen_array
-from align.wellformed import array_field, malformed
+from align.wellformed import array_field, check_inverse, malformed
 
 FORMAT = "imu-align.calibration"
 CONVENTION = "raw = M true + bias; true = M^-1 (raw - bias); rows of M are sensor axes"
@@ -201,6 +201,13 @@ class CalibrationSet(Result, format=FORMAT, convention=CONVENTION):
     def from_dict(cls, d: dict, where: str = "calibration") -> CalibrationSet:
         """Read the form written by :meth:`to_dict` (any version up to the current one)."""
         cls.check_envelope(d, where, keys=["inputs", *SENSORS])
+        for k in SENSORS:  # a hand-edited A (the reader takes M) is refused, not ignored
+            if isinstance(d.get(k), dict) and "M" in d[k] and "A" in d[k]:
+                try:
+                    m, a = np.array(d[k]["M"], dtype=float), np.array(d[k]["A"], dtype=float)
+                except (TypeError, ValueError):
+                    continue  # malformed: Calibration.from_dict says so
+                check_inverse(m, a, where, f"{k}.")
         sensors = {k: Calibration.from_dict(d[k], f"{where}: {k}") for k in SENSORS if k in d}
         if not sensors:
             raise InputError(f"holds no {' or '.join(SENSORS)} calibration", where)

@@ -50,7 +50,6 @@ def _load(path: Path):
     saying what to give, and one whose ``A`` is not ``M^-1`` one naming the field."""
     from align.errors import InputError
     from align.io import read_json
-    from align.present.exportchecks import check_inverses
     from align.results import result_from_dict
 
     try:
@@ -61,7 +60,6 @@ def _load(path: Path):
         raise  # missing, a folder, unreadable: said as it is
     if not isinstance(d.get("format"), str) or not d["format"].startswith("imu-align."):
         raise InputError(NOT_A_RESULT, str(path))
-    check_inverses(d, str(path))
     return result_from_dict(d, str(path))
 
 

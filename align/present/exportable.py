@@ -37,7 +37,7 @@ from align.io.noise_consumers import CONSUMERS, entries, header_lines
 from align.noise.job import AllanJob
 from align.parts import Part
 from align.present.angles import DEFINITIONS, angle_rows
-from align.present.exportchecks import c_values, check_inverse
+from align.present.exportchecks import c_values
 from align.present.noise_figures import Exported, consumer_rate, gather, noise_export, noise_summary, select
 from align.results import Result
 from align.units import to_unit
@@ -335,9 +335,6 @@ def export(results: list[tuple[Result, str]], to: str, name: str | None = None, 
     """
     if to not in EXPORTS:
         raise InputError(f"unknown export '{literal(to)}'; choose {', '.join(EXPORTS)}", "{to}")
-    for r, where in results:
-        if isinstance(r, AlignmentResult):
-            check_inverse(r.M, r.A, where, "")
     if to == "kalibr":
         return _kalibr(results, rostopic, inflate, rate_hz, part, floor_tau)
     if to in NOISE:

@@ -244,3 +244,17 @@ def test_a_hand_edited_a_and_an_overflowing_bias_are_refused_naming_the_field(fi
     assert not out.exists()
     # within the tolerance (the JSON's own rounding) it exports
     assert run_cli("export", tmp_path / "cal.json", "--to", "c", "--out", out).code == 0
+
+
+def test_a_hand_edited_a_is_refused_wherever_the_result_is_read(files, tmp_path):
+    """A = M^-1 is checked by the result's reader (align.wellformed.check_inverse), so apply and the report refuse
+    an edited file as export does, not only export."""
+    from align.errors import InputError
+    from align.results import load_result
+
+    d = json.loads((files / "align.json").read_text())
+    d["A"][1][2] += 1e-3
+    (tmp_path / "edited.json").write_text(json.dumps(d))
+    with pytest.raises(InputError, match="not the inverse of M") as exc:
+        load_result(tmp_path / "edited.json")
+    assert exc.value.where.endswith("edited.json: A")
