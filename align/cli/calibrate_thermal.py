@@ -4,7 +4,7 @@ column, and the autopilots' parameter files; the work is the library job
 
 Public names
 ------------
-thermal, thermal_options, thermal_files, thermal_summary
+thermal, thermal_options, thermal_files
 """
 
 from __future__ import annotations
@@ -98,34 +98,6 @@ def thermal_files(result: ThermalCalibration, inputs: ThermalInputs, params: dic
     return out
 
 
-def thermal_summary(result: ThermalCalibration) -> str:
-    """Per sensor and axis: order, lag, residual before/after (rms, largest), one cubic, band, hysteresis, the
-    held-out branch check; the reference temperature and the valid range."""
-    from align.units import to_unit
-
-    lines = []
-    for name, s in result.sensors.items():
-        u, m = s.units, s.model
-
-        def v(x: float, u: str = u) -> str:
-            return f"{to_unit(x, u):.3g}"
-
-        lines.append(f"{name} ({u}): reference {m.tref:.2f} C, valid {m.tmin:.2f} to {m.tmax:.2f} C (clamped outside), "
-                     f"{s.samples} samples" + (f", {s.branches['heating']} heating, {s.branches['cooling']} cooling"
-                                               if s.branches else ""))
-        lines.append("  axis order lag   rms before  rms after  largest after  one cubic  band 1s    hysteresis (1s) "
-                     "at T      held-out h->c / c->h")
-        for i, a in enumerate(s.axes):
-            h = a.hysteresis
-            hyst = f"{v(h.value)} ({v(h.sigma)}) at {h.at:.1f} C" if h is not None else "-"
-            cross = f"{v(a.crosscheck[0])} / {v(a.crosscheck[1])}" if a.crosscheck is not None else "-"
-            lines.append(f"  {'xyz'[i]:>4} {a.order:>5} {'yes' if a.lag else 'no':<4}  {v(a.rms_before):>10}  "
-                         f"{v(a.rms_after):>9}  {v(a.max_after):>13}  {v(a.rms_cubic):>9}  {v(a.band_max):>8}  "
-                         f"{hyst:<27} {cross}")
-        lines += [f"  note: {n}" for n in s.notes]
-    return "\n".join(lines)
-
-
 def thermal(
     log: opt.Arg("Static log with a temperature column (soak steps or ramps, one orientation).", "LOG"),
     temperature_column: Annotated[str | None, typer.Option("--temperature-column", metavar="NAME", help=(
@@ -187,4 +159,6 @@ def thermal(
 
     result, inputs = THERMAL.run_with_inputs(thermal_options(**params))
     write_run(json_out, result, thermal_files(result, inputs, params))  # all or none
+    from align.present.text import thermal_summary
+
     typer.echo(thermal_summary(result))

@@ -6,7 +6,8 @@ are the result's file units.
 Public names
 ------------
 matrix_text, angle_lines, alignment_summary, budget_summary, allowable_summary, margin_summary,
-allan_summary, plan_summary, calibration_summary, magnetometer_summary, preset_lines (from :mod:`align.present.presets`)
+allan_summary, plan_summary, calibration_summary, magnetometer_summary, thermal_summary,
+preset_lines (from :mod:`align.present.presets`)
 """
 
 from __future__ import annotations
@@ -347,3 +348,32 @@ def magnetometer_summary(c) -> str:
              f"{100 * q['field_spread_after']:.2f} % after; direction coverage {q['coverage']:.3f} (full sphere 0.333)",
              f"  predicted heading error {q['predicted_heading_error_deg']:.2f} deg (1 sigma)"]
     return "\n".join(lines + [f"  note: {n}" for n in d["notes"]])
+
+
+def thermal_summary(result) -> str:
+    """The terminal's lines of a :class:`~align.calibration.thermal.result.ThermalCalibration`. Per sensor and axis:
+    order, lag, residual before/after (rms, largest), one cubic, band, hysteresis, the
+    held-out branch check; the reference temperature and the valid range."""
+    from align.units import to_unit
+
+    lines = []
+    for name, s in result.sensors.items():
+        u, m = s.units, s.model
+
+        def v(x: float, u: str = u) -> str:
+            return f"{to_unit(x, u):.3g}"
+
+        lines.append(f"{name} ({u}): reference {m.tref:.2f} C, valid {m.tmin:.2f} to {m.tmax:.2f} C (clamped outside), "
+                     f"{s.samples} samples" + (f", {s.branches['heating']} heating, {s.branches['cooling']} cooling"
+                                               if s.branches else ""))
+        lines.append("  axis order lag   rms before  rms after  largest after  one cubic  band 1s    hysteresis (1s) "
+                     "at T      held-out h->c / c->h")
+        for i, a in enumerate(s.axes):
+            h = a.hysteresis
+            hyst = f"{v(h.value)} ({v(h.sigma)}) at {h.at:.1f} C" if h is not None else "-"
+            cross = f"{v(a.crosscheck[0])} / {v(a.crosscheck[1])}" if a.crosscheck is not None else "-"
+            lines.append(f"  {'xyz'[i]:>4} {a.order:>5} {'yes' if a.lag else 'no':<4}  {v(a.rms_before):>10}  "
+                         f"{v(a.rms_after):>9}  {v(a.max_after):>13}  {v(a.rms_cubic):>9}  {v(a.band_max):>8}  "
+                         f"{hyst:<27} {cross}")
+        lines += [f"  note: {n}" for n in s.notes]
+    return "\n".join(lines)
