@@ -21,7 +21,7 @@ number. One :class:`~align.errors.InputError` names the field (``{min_dwell}``) 
 
 Public names
 ------------
-Job, Progress, fields_signature, check_options, quantity
+Job, Progress, fields_signature, check_options, quantity, judged, read_limits_of
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ from typing import Any, Generic, TypeVar
 from align.provenance import Provenance, start_hashing
 from align.results import Result
 
-__all__ = ["Job", "Progress", "fields_signature", "check_options", "quantity"]
+__all__ = ["Job", "Progress", "fields_signature", "check_options", "quantity", "judged", "read_limits_of"]
 
 #: ``progress(n)``: n more units of work done (samples read, runs made); the library never draws it
 Progress = Callable[[int], None]
@@ -73,9 +73,14 @@ class Job(Generic[O, I, R]):
     files: Callable[[O], Mapping[str, Path | str | None]]
     summary: str = ""
 
-    def stamp(self, result: R, options: O) -> R:
-        """``result`` with the provenance of this job run with ``options``."""
-        return result.replace(provenance=Provenance.of(self.name, self.files(options), options))
+    def stamp(self, result: R, options: O, limits: Any = None) -> R:
+        """``result`` with the provenance of this job run with ``options``, and its figures of merit judged
+        (:func:`judged`) against ``limits`` (the options' ``limits`` file, read; None: the default limits)."""
+        files = dict(self.files(options))
+        if getattr(options, "limits", None) is not None:
+            files.setdefault("limits", options.limits)  # type: ignore[attr-defined]
+        return result.replace(provenance=Provenance.of(self.name, files, options),
+                              verdicts=judged(result, self.name, limits))
 
     def run(self, options: O, *, progress: Progress | None = None) -> R:
         """Read, check and compute: the job's result with its provenance.
@@ -99,9 +104,41 @@ class Job(Generic[O, I, R]):
         """As :meth:`run`, and the checked inputs too (for a caller that also draws them). The input files'
         SHA-256 is computed in the background while the job computes (:func:`align.provenance.start_hashing`)."""
         options = check_options(options)
+        limits = read_limits_of(options)  # before the log: a bad limits file costs no computation
         inputs = self.read(options)
         start_hashing([p for p in self.files(options).values() if p is not None])
-        return self.stamp(self.compute(inputs, options, progress), options), inputs
+        return self.stamp(self.compute(inputs, options, progress), options, limits), inputs
+
+
+def read_limits_of(options: Any) -> Any:
+    """The limits file an options value names in its ``limits`` field, read (:func:`align.limits.read_limits`);
+    None when it names none.
+
+    Raises
+    ------
+    InputError
+        A limits file that cannot be read, naming it.
+    """
+    path = getattr(options, "limits", None)
+    if path is None:
+        return None
+    from align.limits import read_limits
+
+    return read_limits(path)
+
+
+def judged(result: Result, test: str, limits: Any = None) -> tuple:
+    """``result``'s figures of merit (:meth:`~align.results.Result.figures_of_merit`) judged against ``limits`` (an
+    :class:`align.limits.Limits`) with the default limits (:func:`align.judge.judge`), each naming ``test`` as the
+    test it came from."""
+    import dataclasses
+
+    figures = result.figures_of_merit()
+    if not figures:
+        return ()
+    from align.judge import judge
+
+    return judge((dataclasses.replace(f, test=f.test or test) for f in figures), limits)
 
 
 def describe(job: Job[Any, Any, Any]) -> str:

@@ -34,6 +34,7 @@ from align import __version__
 from align.errors import InputError
 from align.io.files import read_json, write_json
 from align.io.keys import check_keys
+from align.merit import Figure
 from align.plausible import check_usable_model
 from align.provenance import Provenance
 from align.units import parse_unit
@@ -57,7 +58,7 @@ KNOWN: dict[str, str] = {
 
 _TYPES: dict[str, type[Result]] = {}
 #: the first keys of every result file
-ENVELOPE_KEYS = ("format", "version", "generator", "convention", "units", "provenance")
+ENVELOPE_KEYS = ("format", "version", "generator", "convention", "units", "provenance", "figures_of_merit")
 
 
 class Correction(Protocol):
@@ -129,6 +130,10 @@ class Result(Value):
     #: (:meth:`align.job.Job.run`); None for a result made by a library function alone. A keyword-only
     #: field of every result type, written in the envelope and not compared by ``==``.
     provenance: Provenance | None
+    #: its figures of merit (:meth:`figures_of_merit`) judged against limits (:func:`align.judge.judge`), stamped by the
+    #: job that made it;
+    #: () before (a library function's result). Written in the envelope as ``figures_of_merit``; not compared by ``==``.
+    verdicts: tuple[Figure, ...]
 
     def __init_subclass__(cls, format: str, convention: str, version: int = 1, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
@@ -136,6 +141,9 @@ class Result(Value):
         if "provenance" not in getattr(cls, "__dataclass_fields__", {}):
             cls.__annotations__ = {**cls.__dict__.get("__annotations__", {}), "provenance": "Provenance | None"}
             cls.provenance = field(default=None, kw_only=True, compare=False)  # type: ignore[assignment]
+        if "verdicts" not in getattr(cls, "__dataclass_fields__", {}):
+            cls.__annotations__ = {**cls.__dict__.get("__annotations__", {}), "verdicts": "tuple[Figure, ...]"}
+            cls.verdicts = field(default=(), kw_only=True, compare=False)  # type: ignore[assignment]
         dataclass(frozen=True, eq=False)(cls)
         register(cls)
 
@@ -144,7 +152,13 @@ class Result(Value):
         d = envelope(self.FORMAT, self.VERSION, self.CONVENTION, units)
         if self.provenance is not None:
             d["provenance"] = self.provenance.to_dict()
+        if self.verdicts:
+            d["figures_of_merit"] = [f.to_dict() for f in self.verdicts]
         return d
+
+    def figures_of_merit(self) -> tuple[Figure, ...]:
+        """Its figures of merit, not yet judged (:class:`align.merit.Figure`); () for a result that gives none."""
+        return ()
 
     @classmethod
     def check_envelope(cls, d: Any, where: str = "result", keys: Iterable[str] | None = None) -> None:
@@ -223,7 +237,19 @@ def result_from_dict(d: Any, where: str = "result") -> Result:
     result = _type_of(d.get("format"), where).from_dict(d, where)
     if d.get("provenance") is not None and result.provenance is None:
         result = result.replace(provenance=Provenance.from_dict(d["provenance"], f"{where}: provenance"))
+    if d.get("figures_of_merit") and not result.verdicts:
+        result = result.replace(verdicts=_figures(d["figures_of_merit"], f"{where}: figures_of_merit"))
     return result
+
+
+def _figures(items: Any, where: str) -> tuple[Figure, ...]:
+    """The judged figures an envelope holds (:meth:`align.merit.Figure.to_dict`)."""
+    if not isinstance(items, list) or not all(isinstance(x, dict) for x in items):
+        raise InputError("expected a list of figures (objects with name, sensor, value, ...)", where)
+    try:
+        return tuple(Figure.from_dict(x) for x in items)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"a figure cannot be read ({exc}); regenerate the file", where) from None
 
 
 _R = TypeVar("_R", bound="Result")

@@ -102,15 +102,16 @@ class Sensor(StrEnum):
 
 
 #: statuses from the best to the worst outcome (INFO judges nothing: it ranks below PASS)
-_RANK = ("INFO", "PASS", "NOT CHECKED", "WARN", "FAIL")
+_RANK = ("INFO", "PASS", "NOT CHECKED", "WARN", "NOT USABLE", "FAIL")
 
 
 class Status(StrEnum):
     """The outcome of a check: the one verdict type of checks, margins, the report and the lot.
 
     ``PASS`` met its requirement; ``WARN`` within the guard band of a limit, or a caution that fails
-    nothing; ``FAIL`` did not meet it; ``NOT_CHECKED`` could not be judged (no data, no limit): never
-    counted as a pass; ``INFO`` a figure shown without a requirement.
+    nothing; ``FAIL`` did not meet it; ``NOT_USABLE`` a figure the test did not determine well enough for
+    its use (its 1-sigma above the limit's ``sigma_max``): it fails as FAIL does; ``NOT_CHECKED`` could not
+    be judged (no data, no limit): never counted as a pass; ``INFO`` a figure shown without a requirement.
 
     Examples
     --------
@@ -123,18 +124,24 @@ class Status(StrEnum):
     PASS = "PASS"
     WARN = "WARN"
     FAIL = "FAIL"
+    NOT_USABLE = "NOT USABLE"
     NOT_CHECKED = "NOT CHECKED"
     INFO = "INFO"
 
     @property
     def rank(self) -> int:
-        """Position from the best (INFO, 0) to the worst (FAIL, 4)."""
+        """Position from the best (INFO, 0) to the worst (FAIL, 5)."""
         return _RANK.index(self.value)
 
     @property
     def judged(self) -> bool:
-        """Whether a requirement was judged (PASS, WARN, FAIL), not NOT CHECKED or INFO."""
-        return self in (Status.PASS, Status.WARN, Status.FAIL)
+        """Whether a requirement was judged (PASS, WARN, NOT USABLE, FAIL), not NOT CHECKED or INFO."""
+        return self in (Status.PASS, Status.WARN, Status.NOT_USABLE, Status.FAIL)
+
+    @property
+    def fails(self) -> bool:
+        """Whether it fails what it judges (FAIL, NOT USABLE): a command exits 4."""
+        return self in (Status.FAIL, Status.NOT_USABLE)
 
     @classmethod
     def parse(cls, text: str | Status) -> Status:

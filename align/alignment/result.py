@@ -91,6 +91,15 @@ class AlignmentResult(Result, format=FORMAT, version=FORMAT_VERSION, convention=
         """The sensor this result corrects: always ``"gyroscope"``."""
         return "gyroscope"
 
+    def figures_of_merit(self) -> tuple:
+        """``M``, its decomposition relative to the nominal mounting and the bias, each with its 1-sigma
+        (:func:`align.keyfigures.matrix_figures`)."""
+        from align.keyfigures import figures_from, matrix_figures, vector_figures
+
+        values = matrix_figures(self.M, self.sigma_M, self.mounting, angle_sigmas_too=True)
+        return figures_from(values | vector_figures("bias", self.bias, self.sigma_bias), "gyroscope",
+                            method=f"rate-table alignment ({self.method})")
+
     def correct(self, g: np.ndarray) -> np.ndarray:
         """Aligned rates ``w = A (g - b)`` (Eq 15) for readings of shape (3,) or (n, 3), rad/s."""
         return self.model.correct(g)

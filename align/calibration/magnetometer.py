@@ -170,6 +170,18 @@ class MagCalibration(Result, format=FORMAT, convention=CONVENTION, version=2):
         """``m_cal = W (raw - h)`` for readings of shape (n, 3), SI or counts."""
         return (np.asarray(raw) - self.hard_iron) @ self.soft_iron.T
 
+    def figures_of_merit(self) -> tuple:
+        """``M = soft_iron^-1`` and its decomposition (no 1-sigma stated), the hard iron with its 1-sigma, the field,
+        coverage, heading error and spread (:mod:`align.keyfigures`)."""
+        from align.keyfigures import figures_from, matrix_figures, vector_figures
+
+        values = (matrix_figures(np.linalg.inv(np.asarray(self.soft_iron, float)), None)
+                  | vector_figures("bias", self.hard_iron, self.sigma_hard_iron)
+                  | {"field": float(self.field), "coverage": float(self.coverage),
+                     "heading_error": float(self.heading_error), "spread": float(self.spread_after)})
+        return figures_from(values, "magnetometer", method=f"ellipsoid fit ({self.model})",
+                            counts=self.units.strip().lower() in ("count", "counts"))
+
     def to_dict(self) -> dict:
         """The versioned JSON form: field quantities in ``self.units``, angles in deg."""
         u = self.units

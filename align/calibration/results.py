@@ -101,6 +101,19 @@ class Calibration(Value):
         object.__setattr__(self, "notes", tuple(self.notes))
         object.__setattr__(self, "rotations", tuple(dict(r) for r in self.rotations))
 
+    def figures_of_merit(self) -> tuple:
+        """``M`` and its decomposition, and the bias, with their 1-sigma; a calibration in counts gives the scale in
+        counts (per SI unit) and the bias in SI (``M^-1 b``, its 1-sigma ``sigma_b / |M_ii|``)."""
+        from align.keyfigures import figures_from, matrix_figures, vector_figures
+
+        counts = self.units.strip().lower() in ("count", "counts")
+        bias, sigma = np.asarray(self.bias, float), np.asarray(self.sigma_bias, float)
+        if counts:
+            bias, sigma = np.linalg.solve(self.M, bias), sigma / np.abs(np.diag(self.M))
+        return (figures_from(matrix_figures(self.M, self.sigma_M, angle_sigmas_too=True), self.sensor,
+                             method=self.method, counts=counts)
+                + figures_from(vector_figures("bias", bias, sigma), self.sensor, method=self.method))
+
     def to_dict(self) -> dict:
         """The JSON form: matrices dimensionless, readings in ``self.units``."""
         u = self.units
@@ -186,6 +199,10 @@ class CalibrationSet(Result, format=FORMAT, convention=CONVENTION):
 
     sensors: dict
     inputs: dict = field(default_factory=dict)
+
+    def figures_of_merit(self) -> tuple:
+        """Every sensor's figures (:meth:`Calibration.figures_of_merit`)."""
+        return tuple(f for cal in self.sensors.values() for f in cal.figures_of_merit())
 
     def __post_init__(self) -> None:
         super().__post_init__()

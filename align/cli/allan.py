@@ -19,7 +19,7 @@ import typer
 
 from align.cli import options as opt
 from align.cli.options import ACCURACY, POSITIVE
-from align.cli.paths import check_outputs, write_run
+from align.cli.paths import check_outputs, judged_outcome, write_run
 from align.cli.progress import progress
 
 GRIDS = ("dense", "octave", "decade")
@@ -49,7 +49,7 @@ def allan_options(logs: Any = (), columns: str | None = None, rate_hz: float | N
                   accuracy: float | str | None = None, noise_ratio: float = 10.0, memory_limit_mb: float = 2000.0,
                   skip_rows: int = 0, comment: str | None = None, delimiter: str | None = None,
                   time_units: str | None = None, time_column: str | None = None, topic: str | None = None,
-                  stamps: str | None = None, **_: Any):
+                  stamps: str | None = None, limits: Path | None = None, **_: Any):
     """The ``allan`` job's options from the command's parameters (Python names, as typer delivers them).
 
     The command, the batch and the report's noise step (``report --allan REC`` with its ``--columns``,
@@ -69,7 +69,7 @@ def allan_options(logs: Any = (), columns: str | None = None, rate_hz: float | N
     if isinstance(accuracy, str):
         accuracy = parse_quantity(accuracy, "angle", "{accuracy}")
     paths = (logs,) if isinstance(logs, (str, Path)) else tuple(logs or ())
-    return AllanOptions(
+    return AllanOptions(limits=limits,
         logs=tuple(Path(p) for p in paths), columns=tuple(opt.names(columns)) if columns is not None else None,
         time_column=time_column or None, rate_hz=rate_hz, gyro_units=gyro_units, units=units,
         format=opt.log_format(skip_rows=skip_rows, comment=comment, delimiter=delimiter, time_units=time_units,
@@ -105,6 +105,7 @@ def allan(
     per_decade: opt.Whole("--per-decade", "Points per decade of the dense grid (1 to 1000).", 1, 1000, "10") = 10,
     modified: opt.Flag("--modified/--no-modified", "Also the modified Allan deviation.") = False,
     json_out: opt.JsonOut = None,
+    limits: opt.Limits = None,
     plot: opt.OptInput("--plot", "Log-log plot with confidence band and fit (PNG).", "FILE.png") = None,
     rate: opt.OptQuantity("--rate", "angular_rate", "Table rate, to plan: draws the target and the averaging time.",
                           "RATE", POSITIVE, "'100 deg/s'") = None,
@@ -124,16 +125,18 @@ def allan(
     """Allan deviation, noise-model fit and noise figures of static recordings."""
     params = dict(locals())
     from align.errors import InputError
+    from align.job import read_limits_of
     from align.noise.jobs import ALLAN
     from align.present.text import allan_summary, plan_summary
 
     if (rate is None) != (accuracy is None):  # before any file is looked at, as before
         raise InputError("give both {rate} and {accuracy} to plan", "{rate}" if rate is None else "{accuracy}")
-    check_outputs(logs, json_out=json_out, plot=plot)
+    check_outputs([*logs, limits], json_out=json_out, plot=plot)
     options = allan_options(**params)
+    limits_read = read_limits_of(options)  # before the log: a bad limits file costs no reading
     inputs = ALLAN.read(options)
     with progress(inputs.samples, "Allan deviation (samples read)") as tick:
-        result = ALLAN.stamp(ALLAN.compute(inputs, options, tick), options)
+        result = ALLAN.stamp(ALLAN.compute(inputs, options, tick), options, limits_read)
     extra = allan_files(result, inputs, params)  # all or none: the plot is drawn before anything is written
     write_run(json_out, result, extra)  # all or none
     typer.echo(allan_summary(result))
@@ -141,6 +144,7 @@ def allan(
         typer.echo(f"note: {note}")
     if result.plan is not None:
         typer.echo("\n" + plan_summary(result.plan))
+    judged_outcome(result)
 
 
 COMMANDS = {"allan": allan}

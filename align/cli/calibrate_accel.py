@@ -15,7 +15,7 @@ import typer
 
 from align.cli import options as opt
 from align.cli.options import DURATION, POSITIVE
-from align.cli.paths import check_outputs, write_run
+from align.cli.paths import check_outputs, judged_outcome, write_run
 
 if TYPE_CHECKING:
     from align.calibration.jobs import AccelInputs, AccelOptions
@@ -29,7 +29,7 @@ def accel_options(*, log: Path, positions: Path | None = None, columns: str | No
                   gravity: str | float | None = None, window: float = 1.0, factor: float = 6.0,
                   init_static: float | None = None, min_static: float = 1.0, skip_rows: int = 0,
                   comment: str | None = None, delimiter: str | None = None, time_units: str | None = None,
-                  topic: str | None = None, stamps: str | None = None, **_: Any) -> AccelOptions:
+                  topic: str | None = None, stamps: str | None = None, limits: Path | None = None, **_: Any) -> AccelOptions:
     """The job's options from the command's parameters (Python names; output options and unknown keys ignored).
 
     Returns
@@ -41,7 +41,8 @@ def accel_options(*, log: Path, positions: Path | None = None, columns: str | No
 
     g = gravity if gravity is None or isinstance(gravity, float) else parse_quantity(gravity, "acceleration",
                                                                                       "{gravity}")
-    return AccelOptions(log=opt.log_source(log, columns, rate_hz=rate_hz, units=accel_units, time_column=time_column,
+    return AccelOptions(limits=limits,
+                        log=opt.log_source(log, columns, rate_hz=rate_hz, units=accel_units, time_column=time_column,
                                            skip_rows=skip_rows, comment=comment, delimiter=delimiter,
                                            time_units=time_units, topic=topic, stamps=stamps),
                         positions=positions, gravity=g, window_s=window, factor=factor, init_static_s=init_static,
@@ -85,6 +86,7 @@ def accel(
                                  "TIME", DURATION, "'50 s'") = None,
     min_static: opt.Quantity("--min-static", "time", "Shortest static interval.", "TIME", DURATION, "'1 s'") = "1 s",
     json_out: opt.JsonOut = None,
+    limits: opt.Limits = None,
     plot: opt.OptInput("--plot", "Picture of the static intervals (PNG).", "OUT.png") = None,
     skip_rows: opt.SkipRows = 0,
     comment: opt.Comment = None,
@@ -95,10 +97,11 @@ def accel(
 ) -> None:
     """Accelerometer multi-position calibration (known orientations, or |a| = g over many attitudes)."""
     params = dict(locals())
-    check_outputs([log, positions], json_out=json_out, plot=plot)
+    check_outputs([log, positions, limits], json_out=json_out, plot=plot)
     from align.calibration.jobs import ACCEL
     from align.present.text import calibration_summary
 
     result, inputs = ACCEL.run_with_inputs(accel_options(**params))
     write_run(json_out, result, accel_files(result, inputs, params))  # all or none
     typer.echo(calibration_summary(result.sensors))
+    judged_outcome(result)

@@ -16,7 +16,7 @@ import typer
 
 from align.cli import options as opt
 from align.cli.options import NONZERO, POSITIVE, names, value
-from align.cli.paths import check_outputs, write_run
+from align.cli.paths import check_outputs, judged_outcome, write_run
 
 if TYPE_CHECKING:
     from align.calibration.jobs import FerrarisOptions
@@ -30,7 +30,7 @@ def ferraris_options(*, log: Path, sections: Path, rate_hz: float, turn_angle: f
                      accel_units: str | None = None, gyro_units: str | None = None, bias: Any = "pairwise",
                      g_sensitivity: bool = True, skip_rows: int = 0, comment: str | None = None,
                      delimiter: str | None = None, topic: str | None = None, stamps: str | None = None,
-                     **_: Any) -> FerrarisOptions:
+                     limits: Path | None = None, **_: Any) -> FerrarisOptions:
     """The job's options from the command's parameters (Python names; output options and unknown keys ignored).
 
     Returns
@@ -45,7 +45,7 @@ def ferraris_options(*, log: Path, sections: Path, rate_hz: float, turn_angle: f
                      rate_hz=rate_hz, units=gyro_units, format=fmt)
     accel = LogSource(path=Path(log), columns=None if accel_columns is None else tuple(names(accel_columns)),
                       rate_hz=rate_hz, units=accel_units, format=fmt)
-    return FerrarisOptions(log=gyro, accel=accel, sections=Path(sections), turn_angle=turn_angle, gravity=gravity,
+    return FerrarisOptions(limits=limits, log=gyro, accel=accel, sections=Path(sections), turn_angle=turn_angle, gravity=gravity,
                            bias=cast(Any, value(bias)), g_sensitivity=g_sensitivity)
 
 
@@ -79,6 +79,7 @@ def ferraris(
     g_sensitivity: opt.Flag("--g-sensitivity/--no-g-sensitivity",
                             "Estimate the gyro's g-sensitivity from the static faces.") = True,
     json_out: opt.JsonOut = None,
+    limits: opt.Limits = None,
     imucal_json: opt.OptInput("--imucal-json", "Also write the result as imucal's JSON.", "FILE.json") = None,
     skip_rows: opt.SkipRows = 0,
     comment: opt.Comment = None,
@@ -88,10 +89,11 @@ def ferraris(
 ) -> None:
     """A Ferraris session (six static faces and a turn about each axis), as imucal records it."""
     params = dict(locals())
-    check_outputs([log, sections], json_out=json_out, imucal_json=imucal_json)
+    check_outputs([log, sections, limits], json_out=json_out, imucal_json=imucal_json)
     from align.calibration.jobs import FERRARIS
     from align.present.text import calibration_summary
 
     result, inputs = FERRARIS.run_with_inputs(ferraris_options(**params))
     write_run(json_out, result, ferraris_files(result, inputs, params))  # all or none
     typer.echo(calibration_summary(result.sensors))
+    judged_outcome(result)

@@ -16,7 +16,7 @@ import typer
 from align.cli import options as opt
 from align.cli.mounting import MountingOption, parse_mounting_option
 from align.cli.options import DURATION, POSITIVE, names
-from align.cli.paths import check_outputs, write_run
+from align.cli.paths import check_outputs, judged_outcome, write_run
 
 if TYPE_CHECKING:
     from align.calibration.jobs import GyroInputs, GyroOptions
@@ -57,7 +57,7 @@ def gyro_options(*, log: Path, gyro_columns: str | None = None, accel_columns: s
                  g_sensitivity: bool = False, frame: Path | None = None,
                  mounting: MountingOption | str | None = None, skip_rows: int = 0, comment: str | None = None,
                  delimiter: str | None = None, time_units: str | None = None, topic: str | None = None,
-                 stamps: str | None = None, **_: Any) -> GyroOptions:
+                 stamps: str | None = None, limits: Path | None = None, **_: Any) -> GyroOptions:
     """The job's options from the command's parameters (Python names; output options and unknown keys ignored).
 
     Returns
@@ -91,7 +91,8 @@ def gyro_options(*, log: Path, gyro_columns: str | None = None, accel_columns: s
             mounting = parse_mounting_option(mounting)
         except ValueError as exc:
             raise InputError(str(exc), "{mounting}") from None
-    return GyroOptions(log=gyro, accel=accel, gravity=gravity, window_s=window, factor=factor, gyro_factor=gyro_factor,
+    return GyroOptions(limits=limits,
+                       log=gyro, accel=accel, gravity=gravity, window_s=window, factor=factor, gyro_factor=gyro_factor,
                        init_static_s=init_static, min_static_s=min_static, intervals=intervals, gyro_range=grange,
                        drop_rotations=drop, g_sensitivity=g_sensitivity, frame=frame,
                        mounting=None if mounting is None else mounting.rows,
@@ -158,6 +159,7 @@ def gyro(
                         "RESULT.json") = None,
     mounting: Mounting = None,
     json_out: opt.JsonOut = None,
+    limits: opt.Limits = None,
     plot: opt.OptInput("--plot", "Picture of the session calibrated: |a| over the poses, |w| over the rotations with "
                        "their turn and residual (PNG).", "SESSION.png") = None,
     skip_rows: opt.SkipRows = 0,
@@ -173,7 +175,7 @@ def gyro(
     --frame or --mounting gives the system frame: M_system = M R (w_accelerometer frame = R w_system).
     """
     params = dict(locals())
-    check_outputs([log, accel_log, frame], json_out=json_out, plot=plot)
+    check_outputs([log, accel_log, frame, limits], json_out=json_out, plot=plot)
     from align.calibration.jobs import GYRO
     from align.present.text import calibration_summary
 
@@ -181,3 +183,4 @@ def gyro(
     write_run(json_out, result, gyro_files(result, inputs, params))  # all or none
     typer.echo(calibration_summary(result.sensors))
     typer.echo(rotation_table(result.sensor("gyroscope").rotations))
+    judged_outcome(result)

@@ -15,7 +15,7 @@ import typer
 
 from align.cli import options as opt
 from align.cli.options import DIP, names, value
-from align.cli.paths import check_outputs, write_run
+from align.cli.paths import check_outputs, judged_outcome, write_run
 
 if TYPE_CHECKING:
     from align.calibration.jobs import MagInputs, MagOptions
@@ -26,7 +26,7 @@ def mag_options(*, log: Path, columns: str | None = None, mag_units: str | None 
                 field: str | float | None = None, model: Any = "symmetric", accel_columns: str | None = None,
                 dip: float | None = None, axis_down: str | None = None, skip_rows: int = 0, comment: str | None = None,
                 delimiter: str | None = None, topic: str | None = None, stamps: str | None = None,
-                **_: Any) -> MagOptions:
+                limits: Path | None = None, **_: Any) -> MagOptions:
     """The job's options from the command's parameters (Python names; output options and unknown keys ignored).
 
     Returns
@@ -45,7 +45,7 @@ def mag_options(*, log: Path, columns: str | None = None, mag_units: str | None 
         f = field
     down = None if axis_down is None else {a: v if isinstance(v, tuple) else Path(v)
                                            for a, v in parse_axis_down(axis_down).items()}
-    return MagOptions(log=opt.log_source(log, columns, units=mag_units, skip_rows=skip_rows, comment=comment,
+    return MagOptions(limits=limits, log=opt.log_source(log, columns, units=mag_units, skip_rows=skip_rows, comment=comment,
                                          delimiter=delimiter, topic=topic, stamps=stamps),
                       accel_columns=None if accel_columns is None else tuple(names(accel_columns)), field=f,
                       model=cast(Any, value(model)), dip=dip, axis_down=down)
@@ -83,6 +83,7 @@ def mag(
     plot: opt.OptInput("--plot", "Picture of the capture before and after, and the heading error (PNG).",
                        "OUT.png") = None,
     json_out: opt.JsonOut = None,
+    limits: opt.Limits = None,
     skip_rows: opt.SkipRows = 0,
     comment: opt.Comment = None,
     delimiter: opt.Delimiter = None,
@@ -95,9 +96,10 @@ def mag(
 
     opts = mag_options(**params)
     files = [v for v in (opts.axis_down or {}).values() if isinstance(v, Path)]
-    check_outputs([log, *files], json_out=json_out, plot=plot)
+    check_outputs([log, *files, limits], json_out=json_out, plot=plot)
     from align.present.text import magnetometer_summary
 
     result, inputs = MAG.run_with_inputs(opts)
     write_run(json_out, result, mag_files(result, inputs, params))  # all or none
     typer.echo(magnetometer_summary(result))
+    judged_outcome(result)

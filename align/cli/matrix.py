@@ -14,7 +14,7 @@ import typer
 
 from align.cli import options as opt
 from align.cli.options import DURATION, PAUSE, POSITIVE, TOLERANCE, value
-from align.cli.paths import check_outputs, write_run
+from align.cli.paths import check_outputs, judged_outcome, write_run
 from align.vocab import Sensor
 
 #: the columns ``matrix`` reads by default, time first (the old spelling of ``--columns``, still accepted)
@@ -32,7 +32,7 @@ def matrix_options(*, log: Path, plan: Path, method: Any = "auto", gyro_units: s
                    axis_to_axis: float | None = None, scale_spec: float | None = None, two_axis_variant: Any = None,
                    earth: bool | None = None, skip_rows: int = 0, comment: str | None = None,
                    delimiter: str | None = None, time_units: str | None = None, topic: str | None = None,
-                   stamps: str | None = None, **_: Any):
+                   stamps: str | None = None, limits: Path | None = None, **_: Any):
     """The :class:`align.alignment.jobs.MatrixOptions` of ``imu-align matrix``'s parameters (SI, as the options
     parse them; output options and unknown keys ignored; a parameter left None keeps the job's default)."""
     from align.alignment.jobs import MatrixOptions
@@ -46,7 +46,7 @@ def matrix_options(*, log: Path, plan: Path, method: Any = "auto", gyro_units: s
     source = opt.log_source(log, columns, rate_hz=rate_hz, units=gyro_units, time_column=time_column,
                             skip_rows=skip_rows, comment=comment, delimiter=delimiter, time_units=time_units, topic=topic,
                             stamps=stamps)
-    return MatrixOptions(log=source, plan=plan, **{k: v for k, v in given.items() if v is not None})
+    return MatrixOptions(limits=limits, log=source, plan=plan, **{k: v for k, v in given.items() if v is not None})
 
 
 def matrix_files(result, inputs, params: dict) -> list[tuple[Path, bytes | str]]:
@@ -76,6 +76,7 @@ def matrix(
     segments: opt.OptInput("--segments", "Explicit segments JSON {name: {start, end}} instead of automatic.",
                        "SEGMENTS.json") = None,
     json_out: opt.JsonOut = None,
+    limits: opt.Limits = None,
     c_header: opt.OptInput("--c-header", "Write A and the bias as a C header here.", "FILE.h") = None,
     gyro_range: opt.OptQuantity("--gyro-range", "angular_rate", "Gyro full scale, e.g. '2000 deg/s': flags saturation.",
                             "RATE", POSITIVE, "'2000 deg/s'") = None,
@@ -111,13 +112,14 @@ def matrix(
 ) -> None:
     """Alignment matrix M and A = M^-1 from rate-table data."""
     params = dict(locals())
-    check_outputs([log, plan, segments], json_out=json_out, c_header=c_header, plot=plot)
+    check_outputs([log, plan, segments, limits], json_out=json_out, c_header=c_header, plot=plot)
     from align.alignment.jobs import MATRIX
     from align.present.text import alignment_summary
 
     result, inputs = MATRIX.run_with_inputs(matrix_options(**params))
     write_run(json_out, result, matrix_files(result, inputs, params))  # all or none: the picture drawn first
     typer.echo(alignment_summary(result))
+    judged_outcome(result)
 
 
 COMMANDS = {"matrix": matrix}

@@ -208,6 +208,11 @@ def value(choice) -> str:
 
 #: where the versioned JSON result goes
 JsonOut = Annotated[Path | None, typer.Option("--json", metavar="FILE.json", help="Write the versioned JSON result here.")]
+#: the limits file the result's figures of merit are judged against (beside the default limits)
+Limits = Annotated[Path | None, typer.Option("--limits", metavar="LIMITS.toml", help=(
+    "Limits the figures of merit are judged against (per figure: min/max/abs_max, sigma_max, guard; per sensor "
+    "tables). Without it, default limits judge whether each figure is determined well enough to use. A figure that "
+    "FAILs or is NOT USABLE exits 4, with the files still written."))]
 #: the random seed of a simulation or a Monte Carlo: a whole number >= 0
 Seed = Annotated[int, typer.Option("--seed", parser=whole(0, example="0"), metavar="N", help="Random seed (>= 0).")]
 

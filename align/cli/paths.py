@@ -14,7 +14,7 @@ no output at all (:func:`outputs`).
 
 Public names
 ------------
-check_outputs, output_folder, outputs, data_files, named_inputs, resolve_named
+check_outputs, output_folder, outputs, data_files, named_inputs, resolve_named, write_run, judged_outcome
 """
 
 from __future__ import annotations
@@ -217,3 +217,23 @@ def write_run(json_out: Path | None, result, files: Iterable[tuple[Path, bytes |
                 out.write_bytes(path, data)
             else:
                 out.write_text(path, data)
+
+
+def judged_outcome(result) -> None:
+    """After a job's files are written: its figures of merit that are not PASS, and the verdict line, on the
+    terminal; exit 4 (:class:`~align.errors.CheckFailed`) when a figure FAILs or is NOT USABLE (the files stay,
+    for diagnosis)."""
+    import typer
+
+    from align.errors import CheckFailed
+    from align.judge import failures
+    from align.present.merit import verdict_lines
+
+    for line in verdict_lines(result.verdicts):
+        typer.echo(line)
+    bad = failures(result.verdicts)
+    if bad:
+        named = ", ".join(f"{f.sensor} {f.name} {f.status}" for f in bad[:3]) + (" ..." if len(bad) > 3 else "")
+        raise CheckFailed(f"{len(bad)} figure{'s' if len(bad) > 1 else ''} of merit fail{'' if len(bad) > 1 else 's'}: "
+                          f"{named} (listed above; files written)")
+

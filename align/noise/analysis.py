@@ -118,6 +118,19 @@ class AllanAnalysis(Result, format=FORMAT, convention=CONVENTION, version=2):
         """True when ``result`` is the pooled curve of several runs."""
         return len(self.run_results) > 1
 
+    def figures_of_merit(self) -> tuple:
+        """The noise terms ``N``, ``B``, ``K`` of the first three channels as x, y, z with their 1-sigma; NaN where
+        the record could not identify a term (never a bound as a value)."""
+        from align.keyfigures import AXES, figures_from
+
+        values: dict[str, float] = {}
+        for a, fit in zip(AXES, self.fits[:3]):
+            for name, index in (("arw", 1), ("bi", 2), ("rrw", 3)):
+                ok = bool(fit.identifiable[index])
+                values[f"{name}_{a}"] = float(fit.params[index]) if ok else float("nan")
+                values[f"{name}_{a}_sigma"] = float(fit.sigma[index]) if ok else float("nan")
+        return figures_from(values, self.sensor, method="Allan variance fit (IEEE Std 952 Annex C)")
+
     def to_dict(self) -> dict[str, Any]:
         """The versioned JSON form: deviations in ``units``, terms in engineering units."""
         r, u, sensor = self.result, self.units, self.sensor

@@ -45,6 +45,8 @@ avar_covariance, avar_covariance_basis, combine_covariance, model_edf, LAGS
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from align.noise.model import model_avar
@@ -91,9 +93,16 @@ def avar_covariance_basis(m, n_phase: float, fs: float, lags: int = LAGS, ramp: 
     Returns
     -------
     ndarray, shape (4, 4, T, T), or (5, 5, T, T) with ``ramp``
-        ``S[a, b]`` in s^-4 times the phase's generalised covariance units (SI), symmetric in ``(a, b)``.
+        ``S[a, b]`` in s^-4 times the phase's generalised covariance units (SI), symmetric in ``(a, b)``; read-only
+        (the basis of the same taus and record length is computed once: every channel of a record shares it).
     """
-    m = np.asarray(m, dtype=float)
+    m = np.ascontiguousarray(m, dtype=float)
+    return _basis(m.tobytes(), float(n_phase), float(fs), int(lags), bool(ramp))
+
+
+@functools.lru_cache(maxsize=32)
+def _basis(m_bytes: bytes, n_phase: float, fs: float, lags: int, ramp: bool) -> np.ndarray:
+    m = np.frombuffer(m_bytes, dtype=float)
     tau0 = 1.0 / fs
     t = len(m)
     ia, ib = np.triu_indices(t)
@@ -139,6 +148,7 @@ def avar_covariance_basis(m, n_phase: float, fs: float, lags: int = LAGS, ramp: 
     out = np.zeros((nk, nk, t, t))
     out[:, :, ia, ib] = s
     out[:, :, ib, ia] = s
+    out.flags.writeable = False
     return out
 
 

@@ -59,22 +59,20 @@ class AllanOptions:
         Any rate or acceleration unit (or count size) instead of ``gyro_units`` (``"g"``, ``"16384 LSB/g"``).
     format : LogFormat
         Preamble, comments, delimiter and time unit of a text record; the topic of a log of several streams.
-    grid : str or tuple of float
-        ``"dense"``, ``"octave"``, ``"decade"`` or explicit taus, s.
-    per_decade : int
-        Points per decade of the dense grid (1 to 1000).
+    grid, per_decade : str or tuple of float, int
+        ``"dense"`` (``per_decade`` points per decade, 1 to 1000), ``"octave"``, ``"decade"`` or explicit taus, s.
     modified : bool
         Also the modified Allan deviation.
-    rate : float or None
-        Table rate to plan for, rad/s (with ``accuracy``; gyro records only).
-    accuracy : float or None
-        Alignment goal to plan for, rad (with ``rate``).
+    rate, accuracy : float or None
+        Table rate (rad/s) and alignment goal (rad) to plan for, both or neither (gyro records only).
     noise_ratio : float
         Plan for noise this many times below the goal (> 0).
     memory_limit : float
         Bytes of phase kept in memory; beyond it, a temporary file.
     periods : tuple of float
         Averaging periods of the bias stability figures, s.
+    limits : Path or None
+        A limits file (:mod:`align.limits`) to judge the figures of merit against; None: the default limits.
     """
 
     logs: tuple[Path, ...]
@@ -92,6 +90,7 @@ class AllanOptions:
     noise_ratio: float = quantity(10.0, "dimensionless", gt=0)
     memory_limit: float = quantity(2e9, "dimensionless", gt=0)
     periods: tuple[float, ...] = (1.0, 10.0)
+    limits: Path | None = None
 
     def __post_init__(self) -> None:
         logs = (self.logs,) if isinstance(self.logs, (str, Path)) else self.logs

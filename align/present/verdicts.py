@@ -21,13 +21,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from align.keyfigures import ANGLE_NAMES, angle_sigmas, angle_vector  # noqa: F401  (their home before)
 from align.present.html import Section, esc, table
 from align.vocab import Status
 
 PASS, FAIL, WARN, INFO, NOT_CHECKED = Status.PASS, Status.FAIL, Status.WARN, Status.INFO, Status.NOT_CHECKED
-#: the angles :func:`angle_vector` returns, in order
-ANGLE_NAMES = ("psi_x", "psi_y", "psi_z", "phi_xy", "phi_xz", "phi_yx", "phi_yz", "phi_zx", "phi_zy",
-               "delta_xy", "delta_xz", "delta_yz", "rot_x", "rot_y", "rot_z")
 
 
 @dataclass(frozen=True)
@@ -126,59 +124,6 @@ def checks_verdict(check: str, checks, what: str) -> Verdict:
         parts.append("not checked: " + "; ".join(f"{n} ({d})" if d else n for n, s, d in got if s == NOT_CHECKED))
     return Verdict(check, Status.worst(judged) if judged else NOT_CHECKED, number, float(passed), "; ".join(parts),
                    unchecked=unchecked)
-
-
-def angle_vector(m: np.ndarray) -> np.ndarray:
-    """The angles of reference section 1 read from ``M`` (already relative to the nominal mounting), rad.
-
-    ``psi_i = atan2(|u_i x e_i|, u_i . e_i)`` (equal to ``acos(u_i . e_i)``, well conditioned near 0),
-    ``phi_ij = asin(u_i . e_j)``, ``delta_ij = asin(u_i . u_j)``, and the rotation vector of the mounting
-    rotation ``R`` with ``R^T`` the nearest proper rotation to ``M`` (:func:`align.model.angles`).
-
-    Returns
-    -------
-    ndarray, shape (15,)
-        In :data:`ANGLE_NAMES` order.
-    """
-    from align.model import angles
-
-    m = np.asarray(m, float)
-    u = m / np.linalg.norm(m, axis=1, keepdims=True)
-    psi = [np.arctan2(np.linalg.norm(np.cross(u[i], np.eye(3)[i])), u[i, i]) for i in range(3)]
-    phi = [np.arcsin(np.clip(u[i, j], -1, 1)) for i in range(3) for j in range(3) if i != j]
-    delta = [np.arcsin(np.clip(u[i] @ u[j], -1, 1)) for i, j in ((0, 1), (0, 2), (1, 2))]
-    return np.concatenate([psi, phi, delta, angles(m).mounting_rotvec])
-
-
-def angle_sigmas(m: np.ndarray, sigma_m: np.ndarray, mounting: np.ndarray | None = None) -> dict:
-    """1-sigma of every angle of ``M N^T`` by first-order propagation of the elements' 1-sigma.
-
-    ``sigma_a^2 = sum_kl (d a / d M_kl)^2 sigma_M,kl^2`` (the elements taken independent, as the result
-    states no covariance), the derivatives by central differences of :func:`angle_vector`.
-
-    Parameters
-    ----------
-    m, sigma_m : ndarray, shape (3, 3)
-        The measured ``M`` and its 1-sigma (NaN: unknown, giving NaN sigmas).
-    mounting : ndarray, shape (3, 3), optional
-        Nominal mounting ``N`` (rows: gyro axes in the system frame); the identity when None.
-
-    Returns
-    -------
-    dict of str -> float
-        :data:`ANGLE_NAMES` -> 1-sigma, rad.
-    """
-    n = np.eye(3) if mounting is None else np.asarray(mounting, float)
-    m = np.asarray(m, float)
-    h = 1e-7
-    jac = np.zeros((len(ANGLE_NAMES), 9))
-    for k in range(9):
-        flat = np.zeros(9)
-        flat[k] = h
-        d = flat.reshape(3, 3)
-        jac[:, k] = (angle_vector((m + d) @ n.T) - angle_vector((m - d) @ n.T)) / (2 * h)
-    var = (jac**2) @ np.square(np.asarray(sigma_m, float)).ravel()
-    return dict(zip(ANGLE_NAMES, np.sqrt(var).tolist()))
 
 
 def worst(rows: list) -> object:

@@ -102,7 +102,8 @@ def test_mpu6050_accelerometer_calibration_agrees_with_the_authors(run_cli, tmp_
         out[units] = tmp_path / f"{units[:3]}.json"
         res = run_cli("calibrate", "accel", log, "--skip-rows", "4", "--columns", "ax,ay,az", "--rate-hz", "100",
                       "--accel-units", units, "--init-static", "36.5 s", "--json", out[units])
-        assert res.code == 0, res.err
+        # ten poses fix the angles poorly (+/- 247 deg): NOT USABLE by the default limits, exit 4, the file written
+        assert res.code == 4 and "NOT USABLE: accelerometer phi_xy" in res.out, (res.out[-600:], res.err)
     counts = json.loads(out["counts"].read_text())
     si = json.loads(out["16384 LSB/g"].read_text())
     m_counts = np.diag(counts["accelerometer"]["M"])                      # counts per m/s^2

@@ -72,6 +72,8 @@ class MatrixOptions:
         Scale-factor spec (1 sigma, relative) of the gyro the two-axis shortcut cannot measure, dimensionless.
     earth : bool
         Model the Earth rate, as far as the plan's table geometry allows, when the plan gives a latitude.
+    limits : Path or None
+        A limits file (:mod:`align.limits`) to judge the figures of merit against; None: the default limits.
     """
 
     log: LogSource
@@ -89,6 +91,7 @@ class MatrixOptions:
     axis_to_axis: float = quantity(0.05 * DEG, "angle", gt=0)
     scale_spec: float = quantity(0.01, "dimensionless", gt=0, le=1)
     earth: bool = True
+    limits: Path | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "log", source(self.log))

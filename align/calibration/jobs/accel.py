@@ -53,6 +53,8 @@ class AccelOptions:
         Initial static period for the threshold (imu_tk), s; None: none.
     min_static_s : float
         Shortest static interval, s.
+    limits : Path or None
+        A limits file (:mod:`align.limits`) to judge the figures of merit against; None: the default limits.
     """
 
     log: LogSource
@@ -62,6 +64,7 @@ class AccelOptions:
     factor: float = quantity(6.0, "dimensionless", gt=0)
     init_static_s: float | None = quantity(None, "time", gt=0)
     min_static_s: float = quantity(1.0, "time", gt=0)
+    limits: Path | None = None
 
     @property
     def detector(self) -> StaticDetector:

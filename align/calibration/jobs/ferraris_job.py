@@ -50,6 +50,8 @@ class FerrarisOptions:
         Accelerometer bias: pairwise (Ferraris, tilt-robust) or least squares.
     g_sensitivity : bool
         Estimate the gyro's g-sensitivity from the static faces.
+    limits : Path or None
+        A limits file (:mod:`align.limits`) to judge the figures of merit against; None: the default limits.
     """
 
     log: LogSource
@@ -59,6 +61,7 @@ class FerrarisOptions:
     gravity: float = quantity(STANDARD_GRAVITY, "acceleration", gt=0)
     bias: Literal["pairwise", "lsq"] = "pairwise"
     g_sensitivity: bool = True
+    limits: Path | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "sections", Path(self.sections))

@@ -78,6 +78,8 @@ class GyroOptions:
         Nominal mounting (rows: the system axis of the accelerometer's x, y, z) giving the system frame.
     mounting_text : str or None
         How the mounting was written (``"+y,-x,+z"``), for the result and messages; default: the rows.
+    limits : Path or None
+        A limits file (:mod:`align.limits`) to judge the figures of merit against; None: the default limits.
     """
 
     log: LogSource
@@ -95,6 +97,7 @@ class GyroOptions:
     frame: Path | None = None
     mounting: tuple[tuple[float, float, float], ...] | None = None
     mounting_text: str | None = None
+    limits: Path | None = None
 
     @property
     def detector(self) -> StaticDetector:

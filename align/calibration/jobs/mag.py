@@ -66,6 +66,8 @@ class MagOptions:
         Axis-down turns for the misalignment: ``{"x": Path or (start, stop), "y": ..., "z": ...}``
         (a file with the log's columns, or samples of the log, stop exclusive); the text
         ``"x=FILE,y=FILE,z=FILE"`` is accepted.
+    limits : Path or None
+        A limits file (:mod:`align.limits`) to judge the figures of merit against; None: the default limits.
     """
 
     log: LogSource
@@ -74,6 +76,7 @@ class MagOptions:
     model: Literal["sphere", "diagonal", "symmetric"] = "symmetric"
     dip: float | None = None
     axis_down: dict[str, Path | tuple[int, int]] | None = None
+    limits: Path | None = None
 
     def __post_init__(self) -> None:
         if isinstance(self.accel_columns, str):
