@@ -171,11 +171,22 @@ class MagCalibration(Result, format=FORMAT, convention=CONVENTION, version=2):
         return (np.asarray(raw) - self.hard_iron) @ self.soft_iron.T
 
     def figures_of_merit(self) -> tuple:
-        """``M = soft_iron^-1`` and its decomposition (no 1-sigma stated), the hard iron with its 1-sigma, the field,
-        coverage, heading error and spread (:mod:`align.keyfigures`)."""
+        """``M = soft_iron^-1`` and its decomposition (their 1-sigma from :attr:`covariance` by ``dM = -M dW M`` when
+        the file has it), the hard iron with its 1-sigma, the field, coverage, heading error and spread
+        (:mod:`align.keyfigures`)."""
         from align.keyfigures import figures_from, matrix_figures, vector_figures
 
-        values = (matrix_figures(np.linalg.inv(np.asarray(self.soft_iron, float)), None)
+        m = np.linalg.inv(np.asarray(self.soft_iron, float))
+        sigma_m = None
+        if self.covariance is not None:  # dM = -M dW M over the upper triangle of W (FULL's order), first order
+            jac = []
+            for k, c in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)):
+                dw = np.zeros((3, 3))
+                dw[k, c] = dw[c, k] = 1.0
+                jac.append((-m @ dw @ m).ravel())
+            j = np.array(jac).T                                                  # (9, 6)
+            sigma_m = np.sqrt(np.clip(np.diag(j @ np.asarray(self.covariance)[3:, 3:] @ j.T), 0, None)).reshape(3, 3)
+        values = (matrix_figures(m, sigma_m, angle_sigmas_too=True)
                   | vector_figures("bias", self.hard_iron, self.sigma_hard_iron)
                   | {"field": float(self.field), "coverage": float(self.coverage),
                      "heading_error": float(self.heading_error), "spread": float(self.spread_after)})
