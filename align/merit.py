@@ -91,5 +91,11 @@ class Figure:
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> Figure:
         """The figure :meth:`to_dict` wrote."""
-        num = {k: math.nan if d.get(k) is None else float(d[k]) for k in ("value", "sigma")}
-        return cls(**{k: d.get(k, "") for k in FIGURE_KEYS if k not in num}, **num)
+        def num(key: str) -> float:
+            return math.nan if d.get(key) is None else float(d[key])
+
+        def text(key: str) -> str:
+            return str(d.get(key, "") or "")
+
+        return cls(text("name"), text("sensor"), num("value"), num("sigma"), text("unit") or "1", text("title"),
+                   text("method"), text("test"), Status.parse(text("status") or "INFO"), text("limit"), text("detail"))

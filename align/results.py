@@ -54,6 +54,7 @@ KNOWN: dict[str, str] = {
     "imu-align.budget": "mechanics.budget",
     "imu-align.drift": "align.navigation.result",
     "imu-align.thermal": "align.calibration.thermal.result",
+    "imu-align.positions": "align.calibration.jobs.positions",
 }
 
 _TYPES: dict[str, type[Result]] = {}

@@ -10,7 +10,8 @@ import align.api as ia
 CALLS = {"matrix": "MatrixOptions", "apply": "ApplyOptions", "allan": "AllanOptions", "plan": "PlanOptions",
          "ferraris": "FerrarisOptions", "calibrate_accel": "AccelOptions", "calibrate_mag": "MagOptions",
          "calibrate_gyro": "GyroOptions", "budget": "BudgetOptions", "allowable": "AllowableOptions",
-         "check": "CheckOptions", "drift": "DriftOptions", "calibrate_thermal": "ThermalOptions"}
+         "check": "CheckOptions", "drift": "DriftOptions", "calibrate_thermal": "ThermalOptions",
+         "calibrate_positions": "PositionsOptions"}
 
 
 @pytest.mark.parametrize("call", CALLS)

@@ -31,7 +31,7 @@ navigation drift
 story      report, demo
 exports    export
 batch      batch, lot
-calibrate  calibrate ferraris | accel | mag | gyro
+calibrate  calibrate ferraris | accel | mag | gyro | thermal | positions
 inspect    inspect (what a log holds, before any job)
 """
 

@@ -4,7 +4,7 @@ library job of :mod:`align.calibration.jobs` with its parse and write.
 
 Public names
 ------------
-app, ferraris, accel, mag, gyro, COMMANDS
+app, ferraris, accel, mag, gyro, thermal, positions, COMMANDS
 """
 
 from collections.abc import Callable
@@ -16,15 +16,16 @@ from align.cli.calibrate_accel import accel
 from align.cli.calibrate_ferraris import ferraris
 from align.cli.calibrate_gyro import gyro
 from align.cli.calibrate_mag import mag
+from align.cli.calibrate_positions import positions
 from align.cli.calibrate_thermal import thermal
 
-__all__ = ["app", "ferraris", "accel", "mag", "gyro", "thermal", "COMMANDS"]
+__all__ = ["app", "ferraris", "accel", "mag", "gyro", "thermal", "positions", "COMMANDS"]
 
 COMMANDS: dict[str, Callable[..., Any]] = {"ferraris": ferraris, "accel": accel, "mag": mag, "gyro": gyro,
-                                           "thermal": thermal}
+                                           "thermal": thermal, "positions": positions}
 
 app = typer.Typer(help="Sensor calibration: Ferraris sessions, accelerometer positions, magnetometer ellipsoid, gyro "
-                       "without a rate table, bias against temperature.",
+                       "without a rate table, bias against temperature, indexed positions with Earth rate.",
                   add_completion=False, rich_markup_mode=None, pretty_exceptions_enable=False)
 for _name, _command in COMMANDS.items():
     app.command(_name)(_command)

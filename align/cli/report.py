@@ -121,12 +121,14 @@ def report(
     topic: opt.Topic = None,
     stamps: opt.Stamps = None,
     parts: PartsFile = None,
+    limits: opt.Limits = None,
 ) -> None:
     """One self-contained HTML report from any subset of results: budget, allowance, alignment, noise, calibrations.
 
     A summary comes first: every check, its verdict and the number behind it. The measured misalignment is
     propagated through the manoeuvre and judged with a guard band of 2 sigma (PASS, WARN within 2 sigma of a
-    limit, FAIL). The exit status is 4 when a check fails; the report is written first. With a measured
+    limit, FAIL). Every result's figures of merit are judged against --limits and the default limits (NOT USABLE
+    when not determined well enough to use). The exit status is 4 when a check fails; the report is written first. With a measured
     alignment the measurement governs: the mounting budget against the allowance is then a design check, shown
     with its verdict, that fails nothing.
     """
@@ -135,7 +137,7 @@ def report(
     if (log is None) != (plan is None):
         raise InputError("give {log} and {plan} together", "{log}" if log is None else "{plan}")
     calibrations, drifts = list(calibration or []), list(drift or [])
-    check_outputs([mount, manoeuvre, log, plan, alignment, allan_log, *calibrations, *drifts, parts_file(parts)[0],
+    check_outputs([mount, manoeuvre, log, plan, alignment, allan_log, *calibrations, *drifts, parts_file(parts)[0], limits,
                    *data_files(mount, manoeuvre)], out=out,
                   results=[alignment, *calibrations, *drifts,
                            allan_log if allan_log is not None and allan_log.suffix.lower() == ".json" else None])
@@ -167,7 +169,7 @@ def report(
             seed=seed, progress=tick, log_format=opt.log_format(**fmt) if given else None, alignment=alignment,
             calibrations=calibrations, drift=drifts, title=title, header=header,
             parts=LazyParts(parts) if mount is not None else None, log_columns=gyro_columns, log_rate_hz=log_rate_hz,
-            spell=opt.speller("report", _flags()))
+            spell=opt.speller("report", _flags()), limits=limits)
     with outputs() as staged:
         staged.write_text(out, done.page)
     typer.echo(done.text + f"\nreport: {out}")

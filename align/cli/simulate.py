@@ -27,6 +27,7 @@ import typer
 
 from align.cli import options as opt
 from align.cli.alignment import GYRO_COLUMNS
+from align.cli.calibrate_positions import simulate_positions
 from align.cli.mounting import MountingOption, parse_mounting_option  # noqa: F401  (re-exported)
 from align.cli.options import DIP, DURATION, NONNEGATIVE, NONZERO, PAUSE, POSITIVE, value
 from align.cli.paths import check_outputs, outputs
@@ -314,7 +315,7 @@ def thermal(
 
 
 #: ``simulate``'s subcommands
-COMMANDS = {"session": session, "poses": poses, "lot": lot, "thermal": thermal}
+COMMANDS = {"session": session, "poses": poses, "lot": lot, "thermal": thermal, "positions": simulate_positions}
 SUBCOMMANDS = tuple(COMMANDS)
 
 app = typer.Typer(help="Simulated inputs with known truth, for rehearsals: a rate-table session, a multi-position "

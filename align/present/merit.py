@@ -2,7 +2,7 @@
 
 Public names
 ------------
-verdict_lines, figures_rows, shown_value
+verdict_lines, figures_rows, shown_value, merit_parts
 """
 
 from __future__ import annotations
@@ -55,11 +55,45 @@ def verdict_lines(figures: tuple[Figure, ...] | list[Figure]) -> list[str]:
     return [*lines, f"verdict: {verdict_line(figs)}{said}"]
 
 
-def figures_rows(figures: tuple[Figure, ...] | list[Figure]) -> list[list[str]]:
+def figures_rows(figures: tuple[Figure, ...] | list[Figure]) -> list[list]:
     """The report's figures-of-merit table: figure, standard name, sensor, value +/- 1-sigma, unit, limit, verdict,
     detail, test."""
     rows = []
     for f in figures:
         value, unit = shown_value(f)
-        rows.append([f.name, f.title, f.sensor, value, unit, f.limit or "none", str(f.status), f.detail, f.test])
+        cls = {"PASS": "pass", "FAIL": "fail", "NOT USABLE": "fail", "WARN": "warn", "NOT CHECKED": "warn"}.get(
+            str(f.status), "info")
+        rows.append([f.name, f.title, f.sensor, value, unit, f.limit or "none", (str(f.status), cls), f.detail, f.test])
     return rows
+
+
+def merit_parts(label: str, result, limits=None) -> tuple | None:
+    """The report's verdict and section of ``result``'s figures of merit, or None for a result that gives none.
+
+    The figures are the result's own verdicts (judged when its job ran) or, with ``limits`` (a read
+    :class:`align.limits.Limits`) or for a result written before verdicts existed, judged here
+    (:func:`align.job.judged`).
+
+    Returns
+    -------
+    (Verdict, Section) or None
+    """
+    from align.job import judged
+    from align.present.html import Section, table
+    from align.present.verdicts import Verdict
+
+    figures = result.verdicts if limits is None and result.verdicts else judged(result, label, limits)
+    if not figures:
+        return None
+    counted = [f for f in figures if f.status != Status.INFO]
+    status = Status.worst(f.status for f in counted) if counted else Status.INFO
+    number = ", ".join(f"{sum(f.status == s for f in counted)} {s}" for s in
+                       (Status.FAIL, Status.NOT_USABLE, Status.WARN, Status.NOT_CHECKED, Status.PASS)
+                       if any(f.status == s for f in counted)) or "no limit applies"
+    verdict = Verdict(f"figures of merit ({label})", status, number, float(len(counted)), verdict_line(figures))
+    head = ("<p>Each figure with its standard name, value and 1-sigma, the limit it was judged against and the "
+            "verdict: NOT USABLE when its 1-sigma exceeds what its use needs, WARN within the guard band of a limit, "
+            "NOT CHECKED when there is no value or no applicable limit (never counted as a pass).</p>")
+    rows = figures_rows(figures)
+    body = table(["figure", "name", "sensor", "value", "unit", "limit", "verdict", "detail", "test"], rows, left=9)
+    return verdict, Section(f"Figures of merit: {label}", head + body)

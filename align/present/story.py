@@ -82,7 +82,7 @@ def _npy(arr: np.ndarray) -> bytes:
 
 
 #: the order of the report's parts after the summary (the inputs come last)
-PARTS = ("measured", "mount", "alignment", "noise", "calibration", "navigation")
+PARTS = ("measured", "mount", "alignment", "noise", "calibration", "merit", "navigation")
 
 
 @dataclass(frozen=True)
@@ -125,7 +125,7 @@ def make_report(mount: Path | None = None, manoeuvre: Path | None = None, log: P
                 drift: Sequence[Path] = (), header: dict | None = None, parts: Mapping | None = None,
                 log_columns: str | None = None, log_rate_hz: float | None = None,
                 spell: Callable[[str, str | None], str] | None = None, allan_options: Any = None,
-                log_time_column: str | None = None) -> Outcome:
+                log_time_column: str | None = None, limits: Path | None = None) -> Outcome:
     """Run every job whose inputs are given, from any subset of them, and build the report.
 
     Parameters
@@ -192,6 +192,9 @@ def make_report(mount: Path | None = None, manoeuvre: Path | None = None, log: P
     if all(x is None for x in (mount, manoeuvre, log, allan, alignment)) and not calibrations and not drift:
         raise InputError("nothing to report: give at least one of {mount}, {manoeuvre}, {log} with {plan}, {alignment}, "
                          "{allan}, {calibration}, {drift}")
+    from align.limits import read_limits
+
+    read = None if limits is None else read_limits(limits)  # before any job: a bad limits file costs no work
     rep = jobs.Report(source or Path)
     b = m = None
     if mount is not None:
@@ -210,6 +213,13 @@ def make_report(mount: Path | None = None, manoeuvre: Path | None = None, log: P
         jobs.calibration_job(rep, path)
     for path in drift:  # the error growth of a navigation result
         jobs.drift_job(rep, path)
+    from align.present.merit import merit_parts
+
+    for label, result in rep.results.items():  # every result's figures of merit, judged (issue 27)
+        judged = merit_parts(label, result, read)
+        if judged is not None:
+            rep.verdicts.append(judged[0])
+            rep.add("merit", judged[1])
     if rep.measured:  # the unit is measured: the budget is a design check and governs nothing
         rep.verdicts = [dataclasses.replace(v, governs=False) if v.design else v for v in rep.verdicts]
     sections = [summary_section(rep.verdicts)]

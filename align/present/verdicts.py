@@ -70,7 +70,7 @@ class Verdict:
     @property
     def failed(self) -> bool:
         """A FAIL that fails the report (a design check's FAIL does not when a measurement governs)."""
-        return self.status == FAIL and self.governs
+        return self.status.fails and self.governs
 
     @property
     def shown(self) -> str:
@@ -133,7 +133,8 @@ def worst(rows: list) -> object:
 
 
 def _cls(status: str) -> str:
-    return {PASS: "pass", FAIL: "fail", WARN: "warn", NOT_CHECKED: "warn"}.get(Status.parse(status), "info")
+    return {PASS: "pass", FAIL: "fail", Status.NOT_USABLE: "fail", WARN: "warn", NOT_CHECKED: "warn"}.get(
+        Status.parse(status), "info")
 
 
 def not_checked(verdicts: list[Verdict]) -> list[str]:
@@ -155,7 +156,7 @@ def summary_line(verdicts: list[Verdict]) -> str:
     'PASS on the 1 check that ran; NOT CHECKED: self-checks: saturation'
     """
     governing = [v for v in verdicts if v.governs]
-    failed = [v for v in governing if v.status == FAIL]
+    failed = [v for v in governing if v.status.fails]
     warned = [v for v in governing if v.status == WARN]
     checked = [v for v in governing if v.status.judged]
     missing = not_checked(verdicts)
@@ -169,7 +170,7 @@ def summary_line(verdicts: list[Verdict]) -> str:
         out = "no requirement checked"
     if missing:
         out += "; NOT CHECKED: " + "; ".join(missing)
-    design = [v for v in verdicts if not v.governs and v.status == FAIL]
+    design = [v for v in verdicts if not v.governs and v.status.fails]
     if design:
         out += "; design check " + ", ".join(f"{v.check} FAIL ({v.number})" for v in design) + \
             ": the measured unit governs"
@@ -181,7 +182,7 @@ def summary_section(verdicts: list[Verdict]) -> Section:
     if not verdicts:
         return Section("Summary", "<p>No check: no input was given that a requirement applies to.</p>")
     governing = [v for v in verdicts if v.governs]
-    failed = [v for v in governing if v.status == FAIL]
+    failed = [v for v in governing if v.status.fails]
     warned = [v for v in governing if v.status == WARN]
     checked = [v for v in governing if v.status.judged]
     unchecked = not_checked(verdicts)  # never counted as passed

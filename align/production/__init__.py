@@ -23,6 +23,7 @@ Journal, make_pool, Task, BatchRun, plan_tasks, run_units, run_job, unit_rows, r
 read_spec, lot_statistics, judge_rows, LotStats, FigureStats, LotSpread, LotTruth, simulate_lot
 """
 
+from align.limits import Limit, Spec, read_spec
 from align.production.batch import (
     TABLE,
     UNITS,
@@ -39,7 +40,6 @@ from align.production.keyfigures import FIGURES, result_rows
 from align.production.manifest import Manifest, Unit, input_hash, read_manifest
 from align.production.pools import make_pool
 from align.production.rehearsal import LotSpread, LotTruth, simulate_lot
-from align.production.spec import Limit, Spec, read_spec
 from align.production.stats import FigureStats, LotStats, judge_rows, lot_statistics
 from align.production.table import SCHEMA, Journal, append_rows, latest_rows, read_table
 

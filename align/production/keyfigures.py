@@ -43,7 +43,8 @@ def _reading_unit(sensor: str, units: str) -> str:
 
 def result_rows(result: Result) -> list[dict]:
     """The key figures of a unit's result: one dict per sensor with ``sensor``, ``checks`` (text),
-    ``verdict`` (``"pass"``, or ``"warn"`` when a check of the result warns), ``bias_unit`` and the
+    ``verdict`` (``"pass"``; ``"warn"`` when a check of the result warns or a figure of merit is within its guard
+    band; ``"fail"`` when a figure of merit FAILs or is NOT USABLE, named in ``checks``), ``bias_unit`` and the
     figures of :data:`FIGURES` it has (SI).
 
     Parameters
@@ -52,11 +53,32 @@ def result_rows(result: Result) -> list[dict]:
         An alignment (``imu-align.alignment``), a calibration (``imu-align.calibration``), a magnetometer
         calibration (``imu-align.magnetometer``) or an Allan job (``imu-align.allan``).
 
+        Any other result gives its figures of merit (:meth:`~align.results.Result.figures_of_merit`), one row per
+        sensor.
+
     Returns
     -------
     list of dict
-        Empty for a result of any other kind (the unit's row then holds no figures).
+        Empty for a result that gives no figures (the unit's row then holds none).
     """
+    return _with_merit(_rows(result), result)
+
+
+def _with_merit(rows: list[dict], result: Result) -> list[dict]:
+    """Each row's verdict with its sensor's judged figures of merit (``result.verdicts``)."""
+    for row in rows:
+        mine = [f for f in result.verdicts if f.sensor == row["sensor"]]
+        bad = [f for f in mine if f.status.fails]
+        if bad:
+            named = ", ".join(f"{f.name} {f.status}" for f in bad[:6]) + (" ..." if len(bad) > 6 else "")
+            row["verdict"] = "fail"
+            row["checks"] = "; ".join(x for x in (row.get("checks"), f"figures of merit: {named}") if x)
+        elif row["verdict"] == "pass" and any(f.status == "WARN" for f in mine):
+            row["verdict"] = "warn"
+    return rows
+
+
+def _rows(result: Result) -> list[dict]:
     kind = type(result).FORMAT
     res: Any = result  # one of the kinds below, told apart by its format
     if kind == "imu-align.alignment":
@@ -83,7 +105,16 @@ def result_rows(result: Result) -> list[dict]:
                  "heading_error": float(res.heading_error), "spread": float(res.spread_after)}]
     if kind == "imu-align.allan":
         return [_allan_row(res)]
-    return []
+    figures = result.verdicts or result.figures_of_merit()
+    by_sensor: dict[str, dict] = {}
+    for f in figures:
+        row = by_sensor.setdefault(f.sensor, {"sensor": f.sensor, "checks": "", "verdict": "pass",
+                                              "bias_unit": _UNITS["reading"].get(f.sensor, ("", ""))[0]})
+        if f.name in KIND and f.unit != "count":
+            row[f.name] = f.value
+            if f"{f.name}_sigma" in KIND:
+                row[f"{f.name}_sigma"] = f.sigma
+    return list(by_sensor.values())
 
 
 def _allan_row(job) -> dict:

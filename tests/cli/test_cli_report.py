@@ -89,7 +89,8 @@ def test_report_of_calibrations_alone_renders(tmp_path, run_cli):
     res = run_cli("report", "--calibration", mag, "--calibration", fer, "--out", out)
     assert res.code == 0, res.err
     page = out.read_text()
-    assert sections(page)[0] == "Summary" and "without a verdict" in page
+    assert sections(page)[0] == "Summary" and '<p class="banner pass">PASS: all 2 checks passed.</p>' in page
+    assert "figures of merit (calibration ferraris)" in page and "figures of merit (calibration mag)" in page
     assert [s for s in sections(page) if s.startswith("Calibration")] == [
         f"Calibration: magnetometer ({mag})", f"Calibration: accelerometer ({fer})", f"Calibration: gyroscope ({fer})"]
     assert len(pictures(page)) == 1  # the magnetometer's capture, read again from the file the result names
@@ -116,7 +117,8 @@ def test_measured_misalignment_over_the_allowance_fails_at_the_top_and_exits_4(t
     page = out.read_text()
     assert sections(page)[:2] == ["Summary", "Measured misalignment against the allowance"]
     summary = page.split("<h2>Summary</h2>")[1].split("<h2>")[0]
-    assert summary.startswith('<p class="banner fail">FAIL: 1 of 2 checks failed (measured misalignment vs allowance)')
+    assert summary.startswith('<p class="banner fail">FAIL: 1 of 3 checks failed (measured misalignment vs allowance)')
+    assert "figures of merit (alignment)" in summary                   # the third: judged by the default limits
     # the number behind it: one turn of 30 deg about z gives the x gyro sin(phi_xz) 30 deg (Eq 11-13 for a fixed axis,
     # exact), phi_xz the alignment result's (matrix --json), against the 1/6 deg limit
     d = json.loads(align_json.read_text())

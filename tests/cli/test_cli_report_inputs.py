@@ -76,7 +76,7 @@ def test_within_the_guard_band_is_warn_and_counted(tmp_path, run_cli):
     assert res.code == 0, res.err
     assert "measured vs allowance: WARN" in res.out and "summary: WARN (measured misalignment vs allowance" in res.out
     page = out.read_text()
-    assert '<p class="banner warn">WARN: none of 2 checks failed; 1 WARN (measured misalignment vs allowance)' in page
+    assert '<p class="banner warn">WARN: none of 3 checks failed; 1 WARN (measured misalignment vs allowance)' in page
     assert "Guard band k = 2" in page
 
 
