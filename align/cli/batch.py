@@ -131,9 +131,10 @@ def batch(
     outside = len(run.lot("ok", "fail"))
     if failed:
         raise TestError(f"{failed} of {run.total} units failed or gave an error"
-                        + (f", {outside} outside the spec" if outside else "") + " (listed above)", "batch")
+                        + (f", {outside} outside the spec or their limits" if outside else "") + " (listed above)",
+                        "batch")
     if outside:
-        raise CheckFailed(f"{outside} of {run.total} units outside the spec (listed above)", "batch")
+        raise CheckFailed(f"{outside} of {run.total} units outside the spec or their limits (listed above)", "batch")
 
 
 def lot(

@@ -72,7 +72,8 @@ def _with_merit(rows: list[dict], result: Result) -> list[dict]:
         if bad:
             named = ", ".join(f"{f.name} {f.status}" for f in bad[:6]) + (" ..." if len(bad) > 6 else "")
             row["verdict"] = "fail"
-            row["checks"] = "; ".join(x for x in (row.get("checks"), f"figures of merit: {named}") if x)
+            row["message"] = f"figures of merit: {named}"
+            row["checks"] = "; ".join(x for x in (row.get("checks"), row["message"]) if x)
         elif row["verdict"] == "pass" and any(f.status == "WARN" for f in mine):
             row["verdict"] = "warn"
     return rows

@@ -11,7 +11,10 @@ For each figure (and sensor) over the units that gave it:
 * the trend: least-squares slope of the figure over the lot's order (per unit) or time (per day),
   with its standard error ``s_res / sqrt(sum (x - mean x)^2)``;
 * an individuals control chart: centre the mean, limits ``mean -/+ 3 MR/1.128`` (``MR`` the mean moving
-  range in lot order), and the units outside them.
+  range in lot order), and the units outside them;
+* with a limit, :class:`align.production.capability.Capability`: the percentile Cpk (ISO 22514-2) beside the
+  normal one and which is shown (an Anderson-Darling test); an I-MR chart in lot order (limits from the lot's
+  first units) with the Western Electric run rules that fire (:mod:`align.production.control`).
 
 Populations are never pooled across jobs or units: a figure's statistics are grouped by (job, sensor,
 the row's reading unit ``bias_unit``), so a calibration in counts is described in counts, apart from SI
@@ -39,6 +42,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from align.production.capability import BOOTSTRAP, Capability, capability
+from align.production.control import ControlChart, control_chart
 from align.production.keyfigures import FIGURES, KIND, shown_unit, si_unit
 from align.production.spec import Limit, Spec
 from align.units import to_unit
@@ -97,7 +102,8 @@ class FigureStats:
     """One figure of one sensor over the lot (SI; ``unit`` is the one it is shown in).
 
     ``serials``, ``x`` (lot order or days) and ``values`` are the units that gave it, in lot order;
-    ``outliers`` and ``out_of_control`` name serials.
+    ``outliers`` and ``out_of_control`` name serials. ``capability`` (with a limit) holds both Cpk and the one
+    shown; ``chart`` the I-MR chart in the order of ``x`` and its run rules' signals.
     """
 
     figure: str
@@ -124,6 +130,8 @@ class FigureStats:
     out_of_control: tuple
     job: str = ""
     reading_unit: str = ""
+    capability: Capability | None = None
+    chart: ControlChart | None = None
 
     @property
     def n(self) -> int:
@@ -310,7 +318,9 @@ def _figure(rows: list[dict], figure: str, sensor: str, spec: Spec | None, xs: d
                        float(np.median(v)), c, cs, int(sum(lim.ok(a) for a in v)) if lim else 0,
                        outliers, slope, slope_s, mean, lcl, ucl,
                        tuple(s for s, a in zip(serials, v) if not lcl <= a <= ucl) if math.isfinite(sigma) else (),
-                       job, reading_unit)
+                       job, reading_unit,
+                       capability(v, lim.low, lim.high, resamples=min(BOOTSTRAP, max(200, 4_000_000 // len(v))))
+                       if lim else None, control_chart(v[order], [serials[k] for k in order]))
 
 
 def _unchecked(rows: list[dict], spec: Spec | None) -> list[tuple[Limit, str]]:

@@ -151,7 +151,7 @@ def test_exit_status_and_summary_say_how_many_units_failed(small_lot, tmp_path, 
     res = run_cli("batch", lot.manifest, "--workers", 2, "--out", out, "--spec", spec)
     wrong, off = lot.serials("wrong direction")[0], lot.serials("out of spec")[0]
     assert res.code == 3 and res.err.strip().splitlines() == [
-        "imu-align: error: batch: 1 of 8 units failed or gave an error, 1 outside the spec (listed above)"]
+        "imu-align: error: batch: 1 of 8 units failed or gave an error, 1 outside the spec or their limits (listed above)"]
     assert "8 units; ran 8, skipped 0 (done before, inputs unchanged); 7 ok (1 outside the spec), 1 failed, 0 errors" \
         in res.out
     lines = {line.split()[0]: line for line in res.out.splitlines() if line.startswith("  ")}
@@ -162,7 +162,7 @@ def test_exit_status_and_summary_say_how_many_units_failed(small_lot, tmp_path, 
     (lot.folder / "sessions" / f"{wrong}.csv").write_bytes((lot.folder / "sessions" / f"{good}.csv").read_bytes())
     res = run_cli("batch", lot.manifest, "--workers", 1, "--out", out, "--spec", spec)
     assert res.code == 4 and "ran 1, skipped 7" in res.out and "8 ok (1 outside the spec), 0 failed" in res.out
-    assert res.err.strip() == "imu-align: error: batch: 1 of 8 units outside the spec (listed above)"
+    assert res.err.strip() == "imu-align: error: batch: 1 of 8 units outside the spec or their limits (listed above)"
     # without the spec every unit passes: exit 0; the table has every run's rows
     res = run_cli("batch", lot.manifest, "--out", out)
     assert res.code == 0 and "ran 0, skipped 8" in res.out and "8 ok, 0 failed" in res.out
