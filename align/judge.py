@@ -78,8 +78,9 @@ def with_defaults(limits: Limits | None) -> Limits:
 
 
 def _where(lim: Limit, limits: Limits) -> str:
-    return DEFAULT_WHERE if lim in _defaults().usability and limits.path != DEFAULT_WHERE and \
-        lim not in limits.limits else limits.path
+    if lim in _defaults().usability and limits.path != DEFAULT_WHERE and lim not in limits.limits:
+        return DEFAULT_WHERE
+    return f"{limits.path}, {lim.key}" if lim.key.startswith("part ") else limits.path
 
 
 def judge_figure(figure: Figure, limits: Limits) -> Figure:

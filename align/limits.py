@@ -20,6 +20,10 @@ in the unit its limit is written in. A scale limit written in % or ppm bounds th
 Two keys limiting one figure of one sensor (``phi_xy`` and ``"phi_*"``) are refused, naming both.
 ``coverage``, ``spread`` and ``heading_error`` apply to magnetometers only.
 
+``part = "ADIS16485"`` (a part of :mod:`align.parts`) adds its datasheet's figures as limits of the gyroscope for
+the figures the file does not limit: ``|delta_*|`` within the axis-to-axis misalignment, ``arw_*`` within the angle
+random walk (or the rate noise density, numerically N in deg/sqrt(s)).
+
 Beside the bounds: ``sigma_max`` (the largest 1-sigma with which the figure is usable: a scale's relative, in
 % or ppm), ``guard`` (the guard band inside a bound: a quantity, or ``"k sigma"`` of the figure's own 1-sigma;
 default ``"2 sigma"``, ISO 14253-1: a value closer to a bound than its expanded uncertainty does not show
@@ -40,7 +44,7 @@ from __future__ import annotations
 import fnmatch
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from align.errors import InputError, literal
@@ -191,6 +195,8 @@ def limits_from_text(text: str, where: str) -> Limits:
 def limits_from_dict(data: dict, where: str) -> Limits:
     """The limits of a parsed limits table (:func:`read_limits`)."""
     limits: list[Limit] = []
+    data = dict(data)
+    part = data.pop("part", None)
     for key, value in data.items():
         if key in SENSORS:
             if not isinstance(value, dict):
@@ -199,6 +205,8 @@ def limits_from_dict(data: dict, where: str) -> Limits:
                 limits += _limits(k, v, key, f"{key}.{k}", where)
         else:
             limits += _limits(key, value, None, key, where)
+    if part is not None:
+        limits += _part_limits(part, limits, where)
     if not limits:
         raise InputError("states no limit; give e.g. phi_xy = { abs_max = \"0.1 deg\" }", where)
     seen: dict[tuple[str, str], Limit] = {}
@@ -329,3 +337,33 @@ def _guard(text, figure: str, key: str, where: str) -> tuple[tuple | None, float
     if bound[0] < 0:
         raise InputError(f"{literal(key)}.guard: must be >= 0 (a quantity, or '2 sigma')", where)
     return bound, GUARD_SIGMAS
+
+
+#: a datasheet figure (:mod:`align.parts`) -> the gyro's key figures it limits and the bound, as ``part = "NAME"``
+#: writes them
+#: (a datasheet's "bias instability" is the Allan floor, 0.664 B, not the fit's B: it limits nothing here)
+_PART_FIGURES = (("axis_to_axis", "angle", "delta_*", "abs_max"), ("arw", "angle_random_walk", "arw_?", "max"),
+                 ("noise_density", "angle_random_walk", "arw_?", "max"))
+
+
+def _part_limits(name, written: list[Limit], where: str) -> list[Limit]:
+    """The limits a part's datasheet gives (``part = "ADIS16405"``): the gyro's non-orthogonality within its
+    axis-to-axis misalignment, its N within its angle random walk (or noise density); only for the figures the
+    file does not limit itself."""
+    from align.parts import get_part
+
+    if not isinstance(name, str):
+        raise InputError("part: give a part's name as a string, e.g. part = \"ADIS16405\"", where)
+    part = get_part(name, f"{where}: part")
+    out: list[Limit] = []
+    for field, dim, pattern, bound in _PART_FIGURES:
+        fig = getattr(part, field)
+        if fig is None:
+            continue
+        part.si(field, dim)  # refuses a figure of the wrong dimension, naming the part
+        key = f"part {part.name}: {field}"
+        taken = {lim.figure for lim in (*written, *out) if lim.bounded and lim.sensor in ("", "gyroscope")}
+        out += [replace(lim, key=key) for lim in _limits(pattern, {bound: fig.value}, "gyroscope", key, where)
+                if lim.figure not in taken]
+    return out
+

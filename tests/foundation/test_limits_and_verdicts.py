@@ -123,3 +123,35 @@ def test_a_good_accelerometer_session_passes(run_cli):
     res = run_cli("calibrate", "accel", XSENS, "--columns", "col0,col1,col2,col3", "--accel-units", "counts",
                   "--gravity", "9.81744 m/s^2", "--init-static", "50 s")
     assert res.code == 0 and "verdict: PASS: 18 figures within their limits" in res.out, res.out[-500:]
+
+
+def test_a_parts_datasheet_gives_limits_for_what_the_file_does_not_limit():
+    text = 'part = "ADIS16485"\n"delta_xy" = { abs_max = "0.2 deg" }\n'
+    limits = limits_from_text(text, "l.toml")
+    deltas = {lim.figure: lim for lim in limits.limits if lim.figure.startswith("delta_")}
+    assert deltas["delta_xy"].key == "delta_xy" and deltas["delta_xz"].key == "part ADIS16485: axis_to_axis"
+    # ADIS16485: axis-to-axis 0.05 deg (align.parts), applied to the gyroscope
+    assert deltas["delta_xz"].high == pytest.approx(0.05 * DEG) and deltas["delta_xz"].sensor == "gyroscope"
+    f = judge([Figure("delta_xz", "gyroscope", 0.06 * DEG, 0.001 * DEG, "rad")], limits)[0]
+    assert f.status == Status.FAIL and "(l.toml, part ADIS16485: axis_to_axis)" in f.limit
+    with pytest.raises(InputError, match="l.toml: part"):
+        limits_from_text('part = "NO-SUCH-PART"\n', "l.toml")
+
+
+ADIS = ROOT.parent / "shared/data/static/adis16405_smac/adis_16405_imu1.csv.gz"
+
+
+@pytest.mark.skipif(not ADIS.exists(), reason="../shared/data not beside the project")
+def test_allan_judges_n_against_the_datasheet_of_its_part(run_cli, tmp_path):
+    """A real ADIS16405 run (N about 2.2 deg/sqrt(h)) against its datasheet's noise density, 0.05 deg/s/sqrt(Hz)
+    (N = 3 deg/sqrt(h)): PASS; against a limit of 1 deg/sqrt(h): FAIL, exit 4, the result written."""
+    limits, out = tmp_path / "limits.toml", tmp_path / "allan.json"
+    limits.write_text('part = "ADIS16405"\n')
+    args = ("allan", ADIS, "--columns", "gyro_x_dps,gyro_y_dps,gyro_z_dps", "--rate-hz", "100", "--json", out)
+    res = run_cli(*args, "--limits", limits)
+    assert res.code == 0 and "verdict: PASS: 3 figures within their limits" in res.out, res.out[-400:]
+    merit = {f["name"]: f for f in json.loads(out.read_text())["figures_of_merit"]}
+    assert "(" + str(limits) + ", part ADIS16405: noise_density)" in merit["arw_x"]["limit"]
+    limits.write_text('"arw_?" = { max = "1 deg/sqrt(h)" }\n')
+    res = run_cli(*args, "--limits", limits)
+    assert res.code == 4 and "FAIL: gyroscope arw_x = 2." in res.out and out.exists()

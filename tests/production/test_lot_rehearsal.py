@@ -64,7 +64,8 @@ def _check_the_batch_ran_every_unit_and_says_how_many_failed(lot):
     assert set(t.index[t.status == "failed"]) == broken
     assert lot["code"] == 3  # units failed
     assert lot["err"].strip().splitlines() == [f"imu-align: error: batch: {len(broken)} of 200 units failed or gave an "
-                                               f"error, {(t.verdict == 'fail').sum()} outside the spec or their limits (listed above)"]
+                                               f"error, {(t.verdict == 'fail').sum()} outside the spec or their limits "
+                                               "(listed above)"]
 
 
 def _check_every_good_unit_s_M_is_within_its_3_sigma_of_truth(lot):
