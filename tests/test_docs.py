@@ -22,6 +22,8 @@ MODULES = [
     "align.calibration.thermal.fit", "align.calibration.thermal.branches", "align.calibration.thermal.checks",
     "align.calibration.thermal.firmware", "align.calibration.thermal.simulate", "align.calibration.thermal.result",
     "align.job",
+    "align.merit", "align.keyfigures", "align.limits", "align.judge",
+    "align.calibration.jobs.positions", "align.calibration.multiposition",
     "align.provenance",
     "align.results",
     "align.api",
