@@ -55,6 +55,8 @@ KNOWN: dict[str, str] = {
     "imu-align.drift": "align.navigation.result",
     "imu-align.thermal": "align.calibration.thermal.result",
     "imu-align.positions": "align.calibration.jobs.positions",
+    "imu-align.warmup": "align.noise.warmup",
+    "imu-align.repeatability": "align.noise.repeatability",
 }
 
 _TYPES: dict[str, type[Result]] = {}

@@ -11,7 +11,7 @@ CALLS = {"matrix": "MatrixOptions", "apply": "ApplyOptions", "allan": "AllanOpti
          "ferraris": "FerrarisOptions", "calibrate_accel": "AccelOptions", "calibrate_mag": "MagOptions",
          "calibrate_gyro": "GyroOptions", "budget": "BudgetOptions", "allowable": "AllowableOptions",
          "check": "CheckOptions", "drift": "DriftOptions", "calibrate_thermal": "ThermalOptions",
-         "calibrate_positions": "PositionsOptions"}
+         "calibrate_positions": "PositionsOptions", "warmup": "WarmupOptions", "repeatability": "RepeatabilityOptions"}
 
 
 @pytest.mark.parametrize("call", CALLS)

@@ -24,6 +24,7 @@ MODULES = [
     "align.job",
     "align.merit", "align.keyfigures", "align.limits", "align.judge",
     "align.calibration.jobs.positions", "align.calibration.multiposition",
+    "align.noise.warmup", "align.noise.repeatability", "align.noise.bias_jobs",
     "align.provenance",
     "align.results",
     "align.api",

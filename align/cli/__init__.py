@@ -23,9 +23,10 @@ options    shared option types and their domains, the field -> flag table, old s
 paths      output checks before the work, the run's all-or-none outputs
 progress   the progress bar of long jobs
 alignment  matrix, apply
-simulate   simulate session | poses | lot
+simulate   simulate session | poses | lot | thermal | positions | warmup | turn-ons
 mechanics  budget, allowable, check
 noise      allan, plan
+bias       warmup, repeatability (the bias settling from turn-on; turn-on to turn-on repeatability)
 parts      parts
 navigation drift
 story      report, demo
@@ -49,6 +50,7 @@ from align import __version__
 from align.cli import (
     alignment,
     batch,
+    bias,
     calibrate,
     exports,
     inspect,
@@ -87,7 +89,7 @@ def _root(
     pass
 
 
-_MODULES = (alignment, mechanics, parts, noise, navigation, story, exports, batch, inspect)
+_MODULES = (alignment, mechanics, parts, noise, bias, navigation, story, exports, batch, inspect)
 for _module in _MODULES:
     for _name, _command in _module.COMMANDS.items():
         app.command(_name)(_command)

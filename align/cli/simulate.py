@@ -27,6 +27,7 @@ import typer
 
 from align.cli import options as opt
 from align.cli.alignment import GYRO_COLUMNS
+from align.cli.bias import simulate_turn_ons, simulate_warmup
 from align.cli.calibrate_positions import simulate_positions
 from align.cli.mounting import MountingOption, parse_mounting_option  # noqa: F401  (re-exported)
 from align.cli.options import DIP, DURATION, NONNEGATIVE, NONZERO, PAUSE, POSITIVE, value
@@ -315,7 +316,8 @@ def thermal(
 
 
 #: ``simulate``'s subcommands
-COMMANDS = {"session": session, "poses": poses, "lot": lot, "thermal": thermal, "positions": simulate_positions}
+COMMANDS = {"session": session, "poses": poses, "lot": lot, "thermal": thermal, "positions": simulate_positions,
+            "warmup": simulate_warmup, "turn-ons": simulate_turn_ons}
 SUBCOMMANDS = tuple(COMMANDS)
 
 app = typer.Typer(help="Simulated inputs with known truth, for rehearsals: a rate-table session, a multi-position "

@@ -20,6 +20,9 @@ jobfile   old name of ``analysisfile``, kept for one release
 records   static records for the Allan deviation read through the one reader and checked (static, gravity, rate, time unit)
 jobs      the family's jobs for the command line, the report, the batch and scripts: AllanOptions, ALLAN, allan
           (static records read and checked -> AllanAnalysis), PlanOptions, PLAN, plan (align.api names them)
+warmup    the warm-up time of a static record (the bias settled within a stated band); result ``imu-align.warmup``
+repeatability turn-on to turn-on bias repeatability with its chi-square interval; result ``imu-align.repeatability``
+bias_jobs the ``warmup`` and ``repeatability`` jobs (align.api names them)
 
 The plot of an Allan job is :func:`align.present.plots.allan_plot_png` (this
 family draws nothing). Note that ``align.noise.allan`` as an attribute of this

@@ -18,12 +18,26 @@ Allan variance of each term (IEEE Std 952 Annex C): ``N^2 / tau``, ``(2 ln 2 / p
 from __future__ import annotations
 
 import numpy as np
-from scipy.signal import lfilter
+from numba import njit
 
 DEG_H = np.pi / 180 / 3600                     # 1 deg/h in rad/s
 ARW = np.pi / 180 / 60                         # 1 deg/sqrt(h) in rad/sqrt(s)
 RRW = np.pi / 180 / 3600 / 60                  # 1 deg/h/sqrt(h) in rad/s/sqrt(s)
 RAMP = np.pi / 180 / 3600 / 3600               # 1 deg/h^2 in rad/s^2
+
+
+@njit(cache=False)
+def _markov_add(out: np.ndarray, w: np.ndarray, phi: float, s: float) -> None:
+    """``out += x`` with ``x_0 = s w_0`` (stationary), ``x_k = phi x_(k-1) + s sqrt(1 - phi^2) w_k``, per column."""
+    n, c = w.shape
+    gain = s * np.sqrt(1.0 - phi * phi)
+    x = s * w[0].copy()
+    for j in range(c):
+        out[0, j] += x[j]
+    for k in range(1, n):
+        for j in range(c):
+            x[j] = phi * x[j] + gain * w[k, j]
+            out[k, j] += x[j]
 
 
 def flicker_markov(n: int, fs: float, b: float, rng: np.random.Generator, channels: int) -> np.ndarray:
@@ -32,6 +46,7 @@ def flicker_markov(n: int, fs: float, b: float, rng: np.random.Generator, channe
     A process of correlation time ``T_j`` and variance ``s^2`` has the one-sided PSD
     ``4 s^2 T_j / (1 + (2 pi f T_j)^2)``; with ``T_j`` spaced by a factor ``r`` in log, the sum approaches
     ``s^2 / (ln(r) f)`` (``integral 4 T / (1 + (2 pi f T)^2) dlnT = 1 / f``), so ``s^2 = B^2 ln(r) / pi``.
+    Each process is the exact AR(1) of its step (``phi = exp(-dt / T_j)``), summed in one compiled pass.
     """
     dt = 1.0 / fs
     t_lo, t_hi = 2.0 / (np.pi * fs), 10.0 * n * dt       # corners from fs/4 down to a tenth of 1/T
@@ -40,10 +55,7 @@ def flicker_markov(n: int, fs: float, b: float, rng: np.random.Generator, channe
     s = np.sqrt(b**2 * np.log(r) / np.pi)
     out = np.zeros((n, channels))
     for t in times:
-        phi = np.exp(-dt / t)
-        w = rng.standard_normal((n, channels)) * s * np.sqrt(1 - phi**2)
-        w[0] = rng.standard_normal(channels) * s
-        out += lfilter([1.0], [1.0, -phi], w, axis=0)
+        _markov_add(out, rng.standard_normal((n, channels)), float(np.exp(-dt / t)), float(s))
     return out
 
 
