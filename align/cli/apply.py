@@ -38,24 +38,16 @@ def apply_options(*, log: Path, alignment: Path, sensor: Any = None, gyro_units:
                         gyro_units=gyro_units)
 
 
-def _csv_bytes(names: list[str], data) -> bytes:
-    """Numeric columns as CSV bytes (pyarrow's writer, full float precision, as ``Outputs.write_csv``)."""
-    import io
-
-    import numpy as np
-    import pyarrow as pa
-    import pyarrow.csv as pcsv
-
-    table = pa.table({n: np.ascontiguousarray(data[:, j]) for j, n in enumerate(names)})
-    buf = io.BytesIO()
-    pcsv.write_csv(table, buf)
-    return buf.getvalue()
-
-
 def apply_files(result, inputs, params: dict) -> list[tuple[Path, bytes | str]]:
     """The corrected CSV ``--out`` and the picture ``--plot`` (drawn before anything is written); ``inputs``: the
     job's checked inputs (the picture shows the log before the correction)."""
-    out: list[tuple[Path, bytes | str]] = [(params["out"], _csv_bytes(list(result.columns), result.table()))]
+    from align.io.files import csv_bytes
+
+    names = list(result.columns)
+    units = {n: result.units for n in names[-3:]} | ({names[0]: result.time_units or "s"} if len(names) > 3 else {})
+    rule = next((c.split(": ", 1)[1] for c in result.CONVENTION.split("; ") if c.startswith(f"{result.sensor}:")), "")
+    wrote = f"apply: {result.sensor} corrected with {Path(params['alignment']).name} ({rule})"
+    out: list[tuple[Path, bytes | str]] = [(params["out"], csv_bytes(names, result.table(), units, wrote))]
     if params.get("plot") is not None:
         from align.present.calplots import apply_traces_png
 

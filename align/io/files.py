@@ -9,7 +9,7 @@ tables read are checked by :mod:`align.io.keys`.
 Public names
 ------------
 existing_file, existing_log, decode_text, read_text, read_toml, read_json, write_json, write_text, write_bytes, write_csv,
-to_json_value
+csv_bytes, stated_units, STATED, to_json_value
 """
 
 from __future__ import annotations
@@ -208,6 +208,51 @@ def to_json_value(x):
     if isinstance(x, np.integer):
         return int(x)
     return x
+
+
+#: the first line of a CSV that states its columns' units: ``# imu-align 0.2.0 apply: w = A (g - b); units: time=s,
+#: gyro_x=deg/s, ...`` (what wrote it, then ``name=unit`` for each column; read back by the CSV reader)
+STATED = "# imu-align "
+
+
+def csv_bytes(names: list[str], data: np.ndarray, units: dict[str, str] | None = None, wrote: str = "") -> bytes:
+    """Numeric columns as CSV bytes (pyarrow's writer, full float precision); with ``units``, a first line that
+    states what wrote the file (``wrote``: ``"apply: w = A (g - b) from r.json"``) and each column's unit
+    (:data:`STATED`), which :func:`stated_units` reads back.
+
+    Examples
+    --------
+    >>> text = csv_bytes(["time", "gyro_x"], np.array([[0.0, 1.5]]), {"time": "s", "gyro_x": "deg/s"}, "apply")
+    >>> stated_units(text.decode().splitlines()[0])
+    {'time': 's', 'gyro_x': 'deg/s'}
+    """
+    import io
+
+    import pyarrow as pa
+    import pyarrow.csv as pcsv
+
+    from align import __version__
+
+    table = pa.table({n: np.ascontiguousarray(data[:, j]) for j, n in enumerate(names)})
+    buf = io.BytesIO()
+    if units:
+        stated = ", ".join(f"{n}={units[n]}" for n in names if n in units)
+        buf.write(f"{STATED}{__version__} {wrote}; units: {stated}\n".replace("\n\n", "\n").encode())
+    pcsv.write_csv(table, buf)
+    return buf.getvalue()
+
+
+def stated_units(first_line: str) -> dict[str, str] | None:
+    """The units a CSV's first line states (:func:`csv_bytes`), or None for a line that states none."""
+    if not first_line.startswith(STATED) or "; units: " not in first_line:
+        return None
+    out = {}
+    for item in first_line.rsplit("; units: ", 1)[1].strip().split(", "):
+        name, sep, unit = item.partition("=")
+        if not sep or not name.strip() or not unit.strip():
+            return None
+        out[name.strip()] = unit.strip()
+    return out
 
 
 def write_csv(path: str | Path, names: list[str], data: np.ndarray) -> None:

@@ -71,7 +71,25 @@ def read_table(path: str | Path, names: list[str] | None = None, time_column: st
         given = ", ".join("{" + k + "}" for k in fmt.streams_given())
         raise InputError(f"{given} apply to logs of several streams (ROS bags, ULog, DataFlash), and a "
                          f"{reader.name} file has one; leave them out", str(path))
+    stated = _stated(p) if reader.text and not fmt.skip_rows and fmt.comment is None else None
+    if stated is not None:  # a CSV imu-align wrote: its first line states the units
+        import dataclasses
+
+        got = Columns.of(reader.read(p, names, time_column, dataclasses.replace(fmt, skip_rows=1)))
+        return dataclasses.replace(got, units={**{n: stated[n] for n in got.names if n in stated}, **got.units})
     return Columns.of(reader.read(p, names, time_column, fmt))
+
+
+def _stated(p: Path) -> dict[str, str] | None:
+    """The units the first line of a text log states (:func:`align.io.files.stated_units`), if it does."""
+    from align.io.files import STATED, stated_units
+
+    with open(p, "rb") as fh:
+        head = fh.read(len(STATED))
+        if head != STATED.encode():
+            return None
+        line = (head + fh.readline(4096)).decode("utf-8", "replace").rstrip("\r\n")
+    return stated_units(line)
 
 
 def parquet_columns(p: Path, names: list[str] | None, time_column: str | None, fmt: LogFormat

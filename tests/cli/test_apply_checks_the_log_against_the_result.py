@@ -4,6 +4,9 @@ in another field unit; and the one column convention (``--columns`` data names w
 
 The truth comes from outside the program: sessions simulated with a known model, written in a known unit."""
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 from support import write_session
@@ -68,7 +71,7 @@ def test_the_same_log_with_the_size_of_one_count_is_corrected_to_the_true_rates(
     out = tmp_path / "c.csv"
     res = run_cli("apply", log, "--alignment", aligned, "--out", out, "--gyro-units", "131 LSB/(deg/s)")
     assert res.code == 0, res.err
-    written = np.loadtxt(out, delimiter=",", skiprows=1)[:, 1:]  # written in the log's unit: counts
+    written = np.loadtxt(out, delimiter=",", skiprows=2)[:, 1:]  # written in the log's unit: counts
     err = np.abs(written / LSB * DEG - w)
     assert np.median(err) < 0.05 * DEG, np.median(err) / DEG
 
@@ -109,7 +112,7 @@ def test_a_gyro_calibration_in_counts_needs_a_count_log_and_writes_deg_s(tmp_pat
     res = run_cli("apply", log, "--alignment", result, "--out", out, "--gyro-units", "counts")
     assert res.code == 0, res.err
     assert "(deg/s)" in res.out and "written in deg/s" in res.out, res.out
-    written = np.loadtxt(out, delimiter=",", skiprows=1)[:, 1:]
+    written = np.loadtxt(out, delimiter=",", skiprows=2)[:, 1:]
     assert np.allclose(written, w / DEG, atol=1e-9)
 
 
@@ -131,7 +134,7 @@ def test_a_gauss_log_read_as_ut_is_refused_though_the_hard_iron_hides_it(tmp_pat
     assert not out.exists()
     res = run_cli("apply", log, "--alignment", result, "--out", out, "--units", "gauss")
     assert res.code == 0, res.err
-    m = np.loadtxt(out, delimiter=",", skiprows=1)[:, 1:]
+    m = np.loadtxt(out, delimiter=",", skiprows=2)[:, 1:]
     assert np.allclose(np.linalg.norm(m, axis=1), np.linalg.norm(m, axis=1).mean(), rtol=1e-6)
 
 
@@ -159,7 +162,8 @@ def test_time_column_and_three_data_columns_on_matrix_and_apply(tmp_path, run_cl
     out = tmp_path / "c.csv"
     res = run_cli("apply", log, "--alignment", a, "--out", out, "--columns", "wx,wy,wz", "--time-column", "stamp")
     assert res.code == 0, res.err
-    assert out.read_text().splitlines()[0].replace('"', "") == "stamp,wx,wy,wz"
+    first, header = out.read_text().splitlines()[:2]
+    assert header.replace('"', "") == "stamp,wx,wy,wz" and first.endswith("units: stamp=s, wx=deg/s, wy=deg/s, wz=deg/s")
 
 
 @pytest.mark.parametrize("command", ["matrix", "apply"])
@@ -180,3 +184,20 @@ def test_a_duplicate_or_missing_column_name_is_one_line_exit_2(tmp_path, run_cli
     line = one_line(run_cli(*args, "--columns", columns, *extra))
     assert "--columns" in line and words in line, line
     assert not (tmp_path / "r.json").exists() and not (tmp_path / "c.csv").exists()
+
+
+def test_the_corrected_csv_states_its_units_and_reads_back_with_them(run_cli, tmp_path):
+    """issue 28: apply's CSV states no unit. Its first line now does; every reader takes it (a unit typed against it
+    is refused) and the corrected session aligns to the identity (A M = I)."""
+    root = Path(__file__).resolve().parents[2] / "examples" / "alignment"
+    result, out = tmp_path / "r.json", tmp_path / "c.csv"
+    assert run_cli("matrix", root / "session.csv", "--plan", root / "plan.toml", "--json", result).code == 0
+    assert run_cli("apply", root / "session.csv", "--alignment", result, "--out", out).code == 0
+    assert out.read_text().startswith("# imu-align ") and "(w = A (g - b), A = M^-1)" in out.read_text()[:200]
+    again = tmp_path / "again.json"
+    res = run_cli("matrix", out, "--plan", root / "plan.toml", "--json", again)
+    assert res.code == 0, res.err
+    m = np.array(json.loads(again.read_text())["M"])
+    assert np.abs(m - np.eye(3)).max() < 1e-6   # its 1-sigma is 1.5e-5
+    res = run_cli("matrix", out, "--plan", root / "plan.toml", "--gyro-units", "rad/s")
+    assert res.code == 2 and "states its readings in deg/s" in res.err and len(res.err.splitlines()) == 1

@@ -150,7 +150,8 @@ def test_apply_writes_the_time_column_back_in_its_unit(run_cli, tmp_path):
     assert run_cli("matrix", log, "--plan", PLAN, "--json", result).code == 0
     res = run_cli("apply", log, "--alignment", result, "--out", tmp_path / "c.csv")
     assert res.code == 0 and "time column read in ms" in res.out, res.err
-    written = np.loadtxt(tmp_path / "c.csv", delimiter=",", skiprows=1)
+    assert "units: time=ms, " in (tmp_path / "c.csv").read_text().splitlines()[0]   # the stated time unit
+    written = np.loadtxt(tmp_path / "c.csv", delimiter=",", skiprows=2)
     np.testing.assert_allclose(written[:, 0], np.loadtxt(log, delimiter=",", skiprows=1)[:, 0], rtol=1e-12)
 
 

@@ -114,7 +114,7 @@ def test_apply_magnetometer_result(tmp_path, run_cli):
     res = run_cli("apply", log, "--alignment", result, "--out", out)
     assert res.code == 0, res.err
     assert "magnetometer" in res.out
-    m = np.loadtxt(out, delimiter=",", skiprows=1)[:, 1:]
+    m = np.loadtxt(out, delimiter=",", skiprows=2)[:, 1:]   # line 1 states the units, line 2 names the columns
     norms = np.linalg.norm(m, axis=1)
     assert norms.std() < 1e-6 * norms.mean()
 

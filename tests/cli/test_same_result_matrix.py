@@ -48,9 +48,10 @@ def test_apply_cli_writes_what_the_library_returns(tmp_path, run_cli):
     assert res.code == 0, res.err
     lib = apply(log=SESSION, alignment=result)
     assert lib.provenance.job == "apply" and {f.role for f in lib.provenance.files} == {"log", "alignment"}
-    header = out.read_text().splitlines()[0]
+    stated, header = out.read_text().splitlines()[:2]
     assert header == ",".join(f'"{c}"' for c in lib.columns) or header == ",".join(lib.columns), header
-    written = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert stated.endswith(f"units: time=s, {', '.join(f'{c}={lib.units}' for c in lib.columns[1:])}")
+    written = np.loadtxt(out, delimiter=",", skiprows=2)
     assert np.allclose(written, lib.table(), rtol=1e-12, atol=1e-12)
     again = APPLY.run(ApplyOptions(log=SESSION, alignment=result))
     assert approx_equal(again, lib) and approx_equal(result_from_dict(json.loads(json.dumps(lib.to_dict()))), lib)
