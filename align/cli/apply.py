@@ -27,13 +27,18 @@ def apply_options(*, log: Path, alignment: Path, sensor: Any = None, gyro_units:
                   units: str | None = None, columns: str | None = None, time_column: str | None = None,
                   rate_hz: float | None = None, skip_rows: int = 0, comment: str | None = None,
                   delimiter: str | None = None, time_units: str | None = None, topic: str | None = None,
-                  stamps: str | None = None, **_: Any):
+                  stamps: str | None = None, temperature_column: str | None = None,
+                  temperature_units: str | None = None, **_: Any):
     """The :class:`align.alignment.jobs.ApplyOptions` of ``imu-align apply``'s parameters (output options and unknown
     keys ignored)."""
+    from dataclasses import replace
+
     from align.alignment.jobs import ApplyOptions
 
     source = opt.log_source(log, columns, rate_hz=rate_hz, units=units, time_column=time_column, skip_rows=skip_rows,
                             comment=comment, delimiter=delimiter, time_units=time_units, topic=topic, stamps=stamps)
+    if temperature_column is not None:
+        source = replace(source, temperature_column=temperature_column, temperature_units=temperature_units)
     return ApplyOptions(log=source, alignment=alignment, sensor=None if sensor is None else value(sensor),
                         gyro_units=gyro_units)
 
@@ -58,8 +63,8 @@ def apply_files(result, inputs, params: dict) -> list[tuple[Path, bytes | str]]:
 
 def apply(
     log: opt.Arg("Log to correct.", "LOG"),
-    alignment: opt.Input("--alignment", "A result of 'matrix', 'calibrate ferraris', 'calibrate accel' or 'calibrate mag'.",
-                     "RESULT.json"),
+    alignment: opt.Input("--alignment", "A result of 'matrix', 'calibrate ferraris', 'calibrate accel', 'calibrate mag' "
+                         "or 'calibrate thermal' (with --temperature-column).", "RESULT.json"),
     out: opt.Input("--out", "Corrected CSV (same columns and units).", "OUT.csv"),
     sensor: opt.Choice("--sensor", ("accelerometer", "gyroscope", "magnetometer"),
                        "The sensor to correct, for a file holding several.") = None,
@@ -77,8 +82,11 @@ def apply(
     time_units: opt.TimeUnits = None,
     topic: opt.Topic = None,
     stamps: opt.Stamps = None,
+    temperature_column: opt.TemperatureColumn = None,
+    temperature_units: opt.TemperatureUnits = None,
 ) -> None:
-    """Correct a log: gyro w = A (g - b); accelerometer M^-1 (a - b); magnetometer soft_iron (m - hard_iron)."""
+    """Correct a log: gyro w = A (g - b); accelerometer M^-1 (a - b); magnetometer soft_iron (m - hard_iron); a thermal
+    calibration raw - bias(T)."""
     params = dict(locals())
     check_outputs([log, alignment], out=out, plot=plot)
     from align.alignment.jobs import APPLY

@@ -100,10 +100,8 @@ def thermal_files(result: ThermalCalibration, inputs: ThermalInputs, params: dic
 
 def thermal(
     log: opt.Arg("Static log with a temperature column (soak steps or ramps, one orientation).", "LOG"),
-    temperature_column: Annotated[str | None, typer.Option("--temperature-column", metavar="NAME", help=(
-        "The temperature column (required)."))] = None,
-    temperature_units: Annotated[str | None, typer.Option("--temperature-units", metavar="UNIT", help=(
-        "Its unit: degC, K or degF (default: the file's, else degC)."))] = None,
+    temperature_column: opt.TemperatureColumn = None,
+    temperature_units: opt.TemperatureUnits = None,
     columns: opt.Columns("Data columns: x,y,z of the one sensor read, or six names (gyro x,y,z then accel x,y,z); "
                          "a time column may lead.", optional=True) = None,
     gyro_columns: opt.Columns("Gyro columns x,y,z (default gyro_x,gyro_y,gyro_z, or gyr_x,... / gx,...).",

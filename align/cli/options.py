@@ -208,6 +208,11 @@ def value(choice) -> str:
 
 #: where the versioned JSON result goes
 JsonOut = Annotated[Path | None, typer.Option("--json", metavar="FILE.json", help="Write the versioned JSON result here.")]
+#: the temperature column of a log and its unit (calibrate thermal; apply with a thermal result)
+TemperatureColumn = Annotated[str | None, typer.Option("--temperature-column", metavar="NAME", help=(
+    "The temperature column (calibrate thermal: required; apply: for a thermal calibration)."))]
+TemperatureUnits = Annotated[str | None, typer.Option("--temperature-units", metavar="UNIT", help=(
+    "Its unit: degC, K or degF (default: the file's, else degC)."))]
 #: the limits file the result's figures of merit are judged against (beside the default limits)
 Limits = Annotated[Path | None, typer.Option("--limits", metavar="LIMITS.toml", help=(
     "Limits the figures of merit are judged against (per figure: min/max/abs_max, sigma_max, guard; per sensor "

@@ -97,6 +97,8 @@ class ApplyInputs:
     time_column : str or None
     columns : tuple of str
         The data columns read.
+    notes : tuple of str
+        What the correction remarks (samples outside a thermal calibration's range, clamped).
     """
 
     log: SensorLog
@@ -109,6 +111,7 @@ class ApplyInputs:
     scale: float
     time_column: str | None
     columns: tuple[str, ...]
+    notes: tuple[str, ...] = ()
 
 
 def _dimension_of(unit: str) -> Any:
@@ -230,7 +233,15 @@ def read_apply(options: ApplyOptions) -> ApplyInputs:
     if got.stated:  # the unit the file states, against the result's
         _log_unit(unit, field, where, correction, kind)
     log = str(src.path)
-    corrected = np.asarray(correction.correct(got.data))
+    notes: tuple[str, ...] = ()
+    if getattr(correction, "needs_temperature", False):  # a thermal calibration: raw - bias(T)
+        if got.temperature is None:
+            raise InputError("a thermal calibration compensates the bias against temperature: give the log's "
+                             "temperature column with {temperature_column}", where)
+        comp = correction.compensate(got.data, got.temperature, got.t)
+        corrected, notes = np.asarray(comp.data), tuple(filter(None, [comp.note]))
+    else:
+        corrected = np.asarray(correction.correct(got.data))
     if expect == "counts":  # a calibration in counts makes accelerometer and gyro readings physical (SI)
         written = kind.unit if kind is not Sensor.MAGNETOMETER else unit
         scale = parse_unit(written).factor if kind is not Sensor.MAGNETOMETER else 1.0
@@ -242,7 +253,7 @@ def read_apply(options: ApplyOptions) -> ApplyInputs:
             _check_gyro(got, correction, unit, field, log)
         elif kind is Sensor.MAGNETOMETER:
             _check_mag(got, correction, corrected, unit, field, log)
-    return ApplyInputs(got, correction, corrected, kind, unit, field, written, float(scale), time, tuple(cols))
+    return ApplyInputs(got, correction, corrected, kind, unit, field, written, float(scale), time, tuple(cols), notes)
 
 
 def compute_apply(inputs: ApplyInputs, options: ApplyOptions, progress: Progress | None = None) -> CorrectedLog:
@@ -256,7 +267,7 @@ def compute_apply(inputs: ApplyInputs, options: ApplyOptions, progress: Progress
     notes = [got.time_note()]
     if inputs.written != inputs.units:
         notes.append(f"readings in {inputs.units} made physical by the calibration: written in {inputs.written}")
-    notes += got.remarks(str(options.log.path))
+    notes += [*inputs.notes, *got.remarks(str(options.log.path))]
     columns = tuple(([inputs.time_column] if inputs.time_column else []) + list(inputs.columns))
     src = options.log
     result = CorrectedLog(

@@ -7,19 +7,19 @@ check). Readings in the file's unit (``units``), temperatures in degrees Celsius
 
 Public names
 ------------
-ThermalCalibration, FORMAT, CONVENTION, BAND, HYSTERESIS
+ThermalCalibration, ThermalCorrection, FORMAT, CONVENTION, BAND, HYSTERESIS
 """
 
 from __future__ import annotations
 
-from dataclasses import field
-from typing import Any
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
 
 import numpy as np
 
 from align.calibration.results import by_sensor
 from align.calibration.thermal.branches import Hysteresis
-from align.calibration.thermal.model import AxisModel, ThermalModel
+from align.calibration.thermal.model import AxisModel, Compensated, ThermalModel
 from align.calibration.thermal.sensor import AxisReport, SensorThermal
 from align.errors import InputError
 from align.io.keys import check_keys
@@ -125,6 +125,13 @@ class ThermalCalibration(Result, format=FORMAT, convention=CONVENTION):
             raise InputError(f"holds {', '.join(self.sensors)}; choose one with {{sensor}}", where)
         return self.sensors[sensor].model
 
+    def correction(self, sensor: str | None = None, where: str = "result") -> ThermalCorrection:
+        """What compensates a log of ``sensor`` (the only one when None) with a temperature column: ``raw - (bias(T) -
+        bias(Tref))`` (:class:`ThermalCorrection`)."""
+        model = self.model(sensor, where)
+        return ThermalCorrection(model, self.sensors[model.sensor].units,
+                                 float(self.inputs.get("settings", {}).get("window_s", 20.0)))
+
     def to_dict(self) -> dict[str, Any]:
         """The versioned JSON form: the envelope, ``inputs``, ``band``, then one key per sensor."""
         out = {**self.envelope({**{k: s.units for k, s in self.sensors.items()}, "temperature": "degC"}),
@@ -173,3 +180,45 @@ class ThermalCalibration(Result, format=FORMAT, convention=CONVENTION):
         if not isinstance(inputs, dict):
             raise InputError("inputs must be an object", f"{where}: inputs")
         return cls(sensors, inputs)
+
+
+@dataclass(frozen=True)
+class ThermalCorrection:
+    """A thermal calibration as :mod:`align.results`' correction of a log (``apply``): ``raw - (bias(T) - bias(Tref))``
+    per axis, the temperature clamped to the valid range as firmware does, the lag term ``lag * dT/dt`` where the model
+    has one (dT/dt over ``window_s``, as the fit took it). Only the change from the reference temperature is removed:
+    the constant of a static session holds gravity (and Earth rate) in its orientation, which the session cannot
+    tell from the bias (as ArduPilot drops the constant term and PX4 writes an accelerometer's X0 as 0); the bias
+    at the reference is a calibration's.
+
+    Attributes
+    ----------
+    model : ThermalModel
+    units : str
+        The unit of the readings in the result's file.
+    window_s : float
+        Window of the temperature rate, s.
+    """
+
+    model: ThermalModel
+    units: str
+    window_s: float = 20.0
+    #: ``apply`` reads the log's temperature column for it
+    needs_temperature: ClassVar[bool] = True
+
+    @property
+    def sensor(self) -> str:
+        """The sensor it compensates."""
+        return self.model.sensor
+
+    def compensate(self, raw: np.ndarray, temperature: np.ndarray, t: np.ndarray) -> Compensated:
+        """``raw`` (n, 3), SI, compensated at ``temperature`` (n,), C, sampled at ``t`` (n,), s
+        (:meth:`ThermalModel.compensate`)."""
+        from align.calibration.thermal.branches import temperature_rate
+
+        lagged = any(ax.lag is not None for ax in self.model.axes)
+        rate = temperature_rate(np.asarray(t, float), np.asarray(temperature, float), self.window_s) if lagged else None
+        comp = self.model.compensate(raw, temperature, rate)
+        at_reference, _ = self.model.bias(np.array([self.model.tref]))
+        return Compensated(comp.data + at_reference, comp.clamped, comp.note)
+

@@ -88,3 +88,34 @@ def test_the_batch_builds_the_same_options():
     o = options_builder("calibrate thermal")(log="x.csv", temperature_column="T", sensors="accel", order=2)
     assert o.sensors == ("accelerometer",) and o.order == 2 and o.log.temperature_column == "T"
     assert files_builder("calibrate thermal") is not None
+
+
+def test_apply_compensates_a_log_with_its_thermal_result_against_the_simulated_truth(tmp_path, run_cli):
+    """Issue 25: `apply` with a thermal result removes the bias's change from the reference temperature. Truth from the
+    simulator (truth.json: sum_k a_k u^k + lag dT/dt, u = (T - tref) / hs, and the hysteresis h/2 the model does not
+    take): what remains of the true change after the compensation is a small part of it."""
+    sim, result, out = tmp_path / "chamber", tmp_path / "r.json", tmp_path / "c.csv"
+    assert run_cli("simulate", "thermal", sim, "--seed", "3").code == 0
+    assert run_cli("calibrate", "thermal", sim / "thermal.csv", "--temperature-column", "temperature", "--json",
+                   result).code == 0
+    args = ("apply", sim / "thermal.csv", "--alignment", result, "--sensor", "accelerometer", "--columns",
+            "acc_x,acc_y,acc_z", "--out", out)
+    refused = run_cli(*args)
+    assert refused.code == 2 and "--temperature-column" in refused.err and not out.exists()
+    res = run_cli(*args, "--temperature-column", "temperature")
+    assert res.code == 0, res.err
+    raw = np.loadtxt(sim / "thermal.csv", delimiter=",", skiprows=1)
+    done = np.loadtxt(out, delimiter=",", skiprows=2)
+    assert out.read_text().startswith("# imu-align ") and "acc_x=m/s^2" in out.read_text().splitlines()[0]
+    truth = json.loads((sim / "truth.json").read_text())["accelerometer"]
+    t, temp = raw[:, 0], raw[:, -1]
+    u, u_ref = (temp - truth["tref"]) / truth["hs"], 0.0
+    k = int(10.0 / (t[1] - t[0]))                             # dT/dt: a centred 20 s difference (the noise averaged)
+    rate = np.gradient(temp, t)
+    rate[k:-k] = (temp[2 * k:] - temp[:-2 * k]) / (t[2 * k:] - t[:-2 * k])
+    for k in range(3):
+        a = np.array(truth["a"][k])
+        change = np.polyval(a[::-1], u) - np.polyval(a[::-1], u_ref) + truth["lag"][k] * rate
+        left = done[:, 1 + k] - (raw[:, 4 + k] - change)     # the compensation's error against the truth
+        left -= np.median(left)                               # the constant: the reference bias, not compensated
+        assert np.sqrt(np.mean(left**2)) < 0.25 * np.sqrt(np.mean((change - change.mean()) ** 2)), k
