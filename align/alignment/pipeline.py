@@ -27,6 +27,7 @@ from align.alignment.checks import (
 )
 from align.alignment.estimate import alignment_sigma, fit_angle_pairs, fit_lsq, fit_rate_pairs
 from align.alignment.geometry import mounting_label
+from align.alignment.linearity import measure_linearity
 from align.alignment.match import Candidate, match_steps
 from align.alignment.observe import EarthModel, Observation, observe
 from align.alignment.plan import Plan
@@ -230,6 +231,7 @@ def align(
     obs, earth_model = observe(t, g, segments, plan, sigma, earth, nominal, [(c.start, c.end) for c in found.unclaimed])
     drift = estimate_drift(obs, t, sigma, nominal)  # the bias change between segments, from the static periods
     obs = list(with_drift(obs, drift, t, sigma))
+    linearity = measure_linearity(obs, plan, nominal, g, options.gyro_range)  # None: one rate per direction
     statics = [o for o in obs if o.segment.kind == "static"]
     rough_bias = (np.mean([o.y for o in statics], axis=0) if statics else np.zeros(3))
     checks.append(check_directions(_measured_turns(obs, plan, rough_bias, nominal), plan, options.rate_tolerance, units,
@@ -254,6 +256,9 @@ def align(
     noise = np.sqrt(np.array([o.var for o in obs]))
     checks.append(check_residuals([o.segment for o in obs], np.abs(fit.residuals).max(axis=1), noise.max(axis=1), units))
     notes.append(_earth_note(plan, earth, earth_model))
+    if linearity is not None and any(a is not None and a.significant for a in linearity.axes):
+        notes.append("the scale factor is not linear across the range (see linearity): M is the least-squares line's, "
+                     "and the rate steps' residuals hold the nonlinearity")
     a = np.linalg.inv(m)
     motions = _motions(t, found.unclaimed, a)
     if motions:
@@ -269,7 +274,7 @@ def align(
         method=method, M=m, A=a, bias=fit.bias, sigma_M=sigma_m, sigma_A=sigma_a,
         sigma_bias=fit.sigma_bias, condition_number=fit.condition_number, dof=fit.dof, segments=reports,
         checks=tuple(checks), notes=tuple(notes), units=units, inferred_axis=missing,
-        mounting=nominal, mounting_source=found.source, motions=motions,
+        mounting=nominal, mounting_source=found.source, motions=motions, linearity=linearity,
     )
 
 

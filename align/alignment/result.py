@@ -15,6 +15,7 @@ import numpy as np
 from align import CONVENTION
 from align.alignment.checks import Check
 from align.alignment.geometry import mounting_axes, mounting_label
+from align.alignment.linearity import Linearity
 from align.alignment.segment import Motion
 from align.errors import InputError
 from align.io import c_header
@@ -44,7 +45,7 @@ class SegmentReport(Value):
 
 #: the keys of an alignment result file after the envelope
 FILE_KEYS = ("sensor", "method", "M", "A", "bias", "uncertainty", "angles", "condition_number", "dof", "inferred_axis",
-             "segments", "checks", "notes", "inputs", "mounting", "motions")
+             "segments", "checks", "notes", "inputs", "mounting", "motions", "linearity")
 
 
 class AlignmentResult(Result, format=FORMAT, version=FORMAT_VERSION, convention=CONVENTION):
@@ -74,7 +75,8 @@ class AlignmentResult(Result, format=FORMAT, version=FORMAT_VERSION, convention=
     mounting: np.ndarray = field(default_factory=lambda: np.eye(3))
     mounting_source: str = "identity"
     motions: tuple[Motion, ...] = ()
-
+    #: the scale factor across the range (a plan with two or more rates in each direction about an axis), else None
+    linearity: Linearity | None = None
 
     @property
     def angles(self) -> Angles:
@@ -97,8 +99,11 @@ class AlignmentResult(Result, format=FORMAT, version=FORMAT_VERSION, convention=
         from align.keyfigures import figures_from, matrix_figures, vector_figures
 
         values = matrix_figures(self.M, self.sigma_M, self.mounting, angle_sigmas_too=True)
-        return figures_from(values | vector_figures("bias", self.bias, self.sigma_bias), "gyroscope",
-                            method=f"rate-table alignment ({self.method})")
+        out = figures_from(values | vector_figures("bias", self.bias, self.sigma_bias), "gyroscope",
+                           method=f"rate-table alignment ({self.method})")
+        if self.linearity is None:
+            return out
+        return out + tuple(f for f in self.linearity.figures() if not f.name.startswith("scale_"))
 
     def correct(self, g: np.ndarray) -> np.ndarray:
         """Aligned rates ``w = A (g - b)`` (Eq 15) for readings of shape (3,) or (n, 3), rad/s."""
@@ -117,7 +122,14 @@ class AlignmentResult(Result, format=FORMAT, version=FORMAT_VERSION, convention=
         return c_header(name, self.A, to_unit(self.bias, self.units), self.units, comment)
 
     def to_dict(self) -> dict:
-        """The versioned JSON form; rates in ``self.units``, angles in deg."""
+        """The versioned JSON form; rates in ``self.units``, angles in deg; ``linearity`` only when measured."""
+        d = self._to_dict()
+        if self.linearity is not None:
+            d["units"]["linearity_rate"] = self.units
+            d["linearity"] = self.linearity.to_dict(parse_unit(self.units).factor)
+        return d
+
+    def _to_dict(self) -> dict:
         u = self.units
         ang = self.angles
         pairs = ("xy", "xz", "yz")
@@ -203,7 +215,9 @@ class AlignmentResult(Result, format=FORMAT, version=FORMAT_VERSION, convention=
                                      cast("tuple[float, float, float]", tuple(float(v) for v in mo["axis"])),
                                      str(mo["label"]))
                               for mo in d.get("motions", [])),
+                linearity=None if d.get("linearity") is None else
+                Linearity.from_dict(d["linearity"], file_unit(d, "linearity_rate", "angular_rate", where)[1]),
             )
-        except (KeyError, TypeError, ValueError) as exc:
+        except (KeyError, TypeError, ValueError, AttributeError) as exc:
             raise InputError(f"malformed alignment result ({malformed(exc)}); regenerate it with imu-align matrix",
                              where) from None

@@ -7,7 +7,9 @@ ramp up at a constant angular acceleration, the dwell (rate steps) or cruise
     g = M (w_table + w_move + w_earth) + b(t) + noise
 
 with ``b(t)`` a turn-on bias plus a random walk and flicker, white noise from a noise
-density, an optional table rate/angle error and saturation at a stated range.
+density, an optional table rate/angle error and saturation at a stated range; each gyro's reading is bent
+by its stated scale-factor asymmetry and nonlinearity (``scale_errors``,
+:class:`~align.alignment.linearity.ScaleErrors`; several rates per axis: its ``linearity_plan``).
 
 The physics is the simulator's own (:mod:`align.alignment.kinematics`, not the estimator's):
 the orientation ``C`` (system axes in ENU) at the start of each step is the step's ``rest``
@@ -34,6 +36,7 @@ import numpy as np
 
 from align import CONVENTION
 from align.alignment import kinematics as kin
+from align.alignment.linearity import ScaleErrors
 from align.alignment.plan import Plan
 from align.alignment.timeline import Move, build_timeline
 from align.errors import InputError
@@ -81,6 +84,9 @@ class SessionSpec:
         Cruise rate of the moves, rad/s.
     flicker : float
         Bias instability coefficient ``B`` of each gyro (flicker, Allan floor ``0.664 B``), rad/s.
+    scale_errors : ScaleErrors or None
+        Each gyro's departure from a straight line (asymmetry, quadratic and cubic terms in its linear reading
+        ``M w``, :class:`~align.alignment.linearity.ScaleErrors`); None: linear.
     """
 
     fs: float = 200.0
@@ -98,6 +104,7 @@ class SessionSpec:
     reorient: bool = False
     move_rate: float = 20.0 * DEG_S
     flicker: float = 0.0
+    scale_errors: ScaleErrors | None = None
 
     def __post_init__(self) -> None:
         """Refuse values outside their domain, each named as its input (``{dwell_s}``, ``{fs}``)."""
@@ -228,7 +235,7 @@ def _simulate(plan: Plan, model: SensorModel, spec: SessionSpec, seed) -> dict:
     if spec.flicker > 0:
         flicker = flicker_fft if n <= FFT_FLICKER_SAMPLES else partial(flicker_gm, bank=12)
         bias = bias + flicker(n, spec.fs, spec.flicker, rng, 3)
-    g = w @ model.M.T + bias + white
+    g = (w @ model.M.T if spec.scale_errors is None else spec.scale_errors.apply(w @ model.M.T)) + bias + white
     if spec.gyro_range is not None:
         g = np.clip(g, -spec.gyro_range, spec.gyro_range)
     if not np.isfinite(g).all():

@@ -8,7 +8,7 @@ modules (the library's unit and format parsers are imported when a value is pars
 Public names
 ------------
 Domain, ANY, POSITIVE, NONNEGATIVE, NONZERO, ACCURACY, DURATION, PAUSE, TOLERANCE, DIP, MAX_RATE_HZ
-(the domains of values); hertz, quantity, checked_text, number, whole, delimiter, comment, time_units, topic,
+(the domains of values); hertz, quantity, checked_text, number, whole, delimiter, comment, time_units, topic, rate_list,
 stamps (values at the edge)
 """
 
@@ -229,3 +229,17 @@ def stamps(text: str) -> str:
     if text not in ("header", "record"):
         raise ValueError("give header (the sensor's time stamps) or record (when the recorder wrote them)")
     return text
+
+
+def rate_list(text: str) -> list[float]:
+    """``'10,30,100 deg/s'`` (``--rates``) -> rad/s, two or more different positive rates."""
+    from align.errors import InputError
+    from align.units import parse_quantity
+
+    *numbers, unit = text.replace(",", " ").split() or [""]
+    if not numbers or unit.replace(".", "", 1).lstrip("+-").isdigit():
+        raise InputError(f"'{text}': give rates with their unit, e.g. '10,30,100,300 deg/s'", "{rates}")
+    out = [parse_quantity(f"{n} {unit}", "angular_rate", "{rates}") for n in numbers]
+    if any(r <= 0 for r in out) or len(set(out)) < 2:
+        raise InputError(f"'{text}': give two or more different positive rates", "{rates}")
+    return out

@@ -123,6 +123,15 @@ def session(
     flicker: opt.Quantity("--flicker", "angular_rate", "Bias instability coefficient B of each gyro (flicker; Allan "
                           "floor 0.664 B).", "RATE", NONNEGATIVE, "'0.005 deg/s'") = "0 deg/s",
     misalignment: Misalignment = "0.5 deg",
+    rates: Annotated[str | None, typer.Option("--rates", metavar="RATES", help=(
+        "Several table rates for the default plan: a cyclic +/- sequence about each axis (scale factor across the "
+        "range), e.g. '10,30,100,300 deg/s'."))] = None,
+    asymmetry: opt.Quantity("--asymmetry", "dimensionless", "Scale-factor asymmetry (K+ - K-)/K of each gyro.", "RATIO",
+                            opt.ANY, "'500 ppm'") = "0 ppm",
+    quadratic: opt.Quantity("--quadratic", "dimensionless", "Quadratic scale-factor term, of full-scale output at full "
+                            "scale.", "RATIO", opt.ANY, "'200 ppm'") = "0 ppm",
+    nonlinearity: opt.Quantity("--nonlinearity", "dimensionless", "Cubic scale-factor term, of full-scale output at "
+                               "full scale.", "RATIO", opt.ANY, "'300 ppm'") = "0 ppm",
     seed: opt.Seed = 0,
     gyro_units: GyroUnitsOut = "deg/s",
     time_units: TimeUnitsOut = "s",
@@ -145,10 +154,18 @@ def session(
 
     parse_unit(gyro_units, "angular_rate", "{gyro_units}")
     if plan is not None:
-        if table_axis is not None:
-            raise InputError("goes with the default plan; the plan file states its table_axis ([test] or [[step]])",
-                             "{table_axis}")
+        if table_axis is not None or rates is not None:
+            raise InputError("goes with the default plan; the plan file states its steps and table_axis",
+                             "{table_axis}" if table_axis is not None else "{rates}")
         the_plan = Plan.from_dict(fileio.read_toml(plan), str(plan))
+    elif rates is not None:
+        from align.alignment.linearity import linearity_plan
+        from align.cli.parsers import rate_list
+
+        if table_axis is not None:
+            raise InputError("the plan across the range turns about each axis pointed up; leave {table_axis} out",
+                             "{rates}")
+        the_plan = linearity_plan(rate_list(rates), latitude=latitude)
     else:
         the_plan = _default_plan(value(kind), rate, angle, table_axis or "up", latitude)
     declared = the_plan.nominal
@@ -161,17 +178,25 @@ def session(
                                        if written else None)
     rng = np.random.default_rng(seed)
     truth = random_model(rng, misalignment, mounting=nominal)
+    from align.alignment.linearity import ScaleErrors, expected_linearity
+
+    full_scale = max((abs(s.rate) for s in the_plan.steps if s.rate is not None), default=0.0)
+    errors = (ScaleErrors.from_full_scale(full_scale, asymmetry, quadratic, nonlinearity)
+              if full_scale and (asymmetry or quadratic or nonlinearity) else None)
     spec = SessionSpec(fs=rate_hz, dwell_s=dwell, static_s=gap, noise_density=noise, bias_walk=bias_walk,
                        latitude=latitude if plan is not None else None, head_s=head, reorient=reorient,
-                       move_rate=move_rate, flicker=flicker)
+                       move_rate=move_rate, flicker=flicker, scale_errors=errors)
     run = simulate_run(the_plan, truth, spec, rng)
+    inputs: dict = {"time_units": value(time_units)}
+    if errors is not None and (lin := expected_linearity(the_plan, truth.M, errors, nominal)) is not None:
+        inputs["linearity"] = lin.to_dict(parse_unit(gyro_units).factor)  # truth.json: the rehearsal's figures
     unit = value(time_units)
     with outputs() as out:  # all or none (a folder it creates is removed again on a failure)
         out.folder(out_dir)
         out.write_csv(out_dir / names[0], GYRO_COLUMNS.split(","),
                       np.column_stack([np.arange(len(run.t)) * (TIME_UNITS[unit] / run.fs), to_unit(run.g, gyro_units)]))
         out.write_text(out_dir / names[1], the_plan.to_toml())
-        out.write_json(out_dir / names[2], SimulationTruth(truth, gyro_units, seed, {"time_units": unit}, nominal,
+        out.write_json(out_dir / names[2], SimulationTruth(truth, gyro_units, seed, inputs, nominal,
                                                            run.moves, run.bias.mean(axis=0)))
     moves = f", {len(run.moves)} re-orientation moves" if run.moves else ""
     typer.echo(f"wrote {out_dir}/session.csv ({len(run.t)} rows, {run.t[-1]:.1f} s{moves}), plan.toml and truth.json")

@@ -83,6 +83,7 @@ def alignment_summary(r: AlignmentResult) -> str:
         unit = "deg" if scale else u
         out.append(f"  {s.name:<32} {s.t_start:9.2f}-{s.t_end:9.2f} s  "
                    + " ".join(f"{a:+.2e}" for a in res) + f"  / {np.max(nz):.1e} {unit}")
+    out += ["", r.linearity.summary(u)] if r.linearity is not None else []
     out += ["", "checks:"] + [f"  [{c.status}] {c.name}: {c.detail}" for c in r.checks]
     out += ["", "notes:"] + [f"  - {n}" for n in r.notes]
     return "\n".join(out)
