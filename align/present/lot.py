@@ -1,13 +1,16 @@
 """A lot for people: the batch's summary, the lot's statistics as text, and its HTML report with pictures.
 
 The report (:func:`lot_report_html`) lists the units that do not pass first, then the statistics of
-every figure against its limit, a histogram per figure with its limits, and an individuals control
-chart per figure over the lot's order (or time) with its control limits and spec limits; pictures
-are matplotlib PNGs embedded as data URIs (:func:`align.present.html.image`).
+every figure against its limit, which Cpk each figure shows and why (normal, or ISO 22514-2 percentile
+when an Anderson-Darling test rejects normality), the control-chart run rules that fired (first unit per
+rule), a histogram per figure with its limits, and an individuals control chart per figure over the lot's
+order (or time) with its control limits and spec limits; pictures are matplotlib PNGs embedded as data URIs
+(:func:`align.present.html.image`).
 
 Public names
 ------------
-batch_summary, lot_summary, lot_report_html, histograms_png, control_charts_png, relative_paths
+batch_summary, lot_summary, lot_report_html, histograms_png, control_charts_png, relative_paths, capability_lines,
+signal_lines
 """
 
 from __future__ import annotations
@@ -69,6 +72,61 @@ def batch_summary(run, manifest: str, where: str, table_path, seconds: float) ->
     return "\n".join(lines)
 
 
+def _cpk_cell(fs) -> str:
+    """The Cpk shown: the normal one ± its standard error, or the percentile one [its 95 % interval] marked ``pct``."""
+    cap = getattr(fs, "capability", None)
+    if fs.limit and cap is not None and cap.used == "percentile":
+        lo, hi = cap.interval
+        return f"{cap.cpk_percentile:.2f} [{lo:.2f}, {hi:.2f}] pct"
+    return f"{fs.cpk:.2f} ± {fs.cpk_sigma:.2f}" if fs.limit and math.isfinite(fs.cpk_sigma) else "-"
+
+
+def _name(fs) -> str:
+    return f"{fs.figure} ({fs.sensor}{', ' + fs.job if fs.job else ''})"
+
+
+def capability_lines(stats) -> list[str]:
+    """One line per figure with a limit: the Cpk shown and why; the other Cpk beside it (flagged when not applicable)."""
+    out = []
+    for fs in stats.figures:
+        cap = getattr(fs, "capability", None)
+        if fs.limit is None or cap is None:
+            continue
+        lo, hi = cap.interval
+        pct = (f"percentile Cpk {cap.cpk_percentile:.2f} (95 % bootstrap interval {lo:.2f} to {hi:.2f})"
+               if math.isfinite(cap.cpk_percentile) else "percentile Cpk -")
+        normal = f"normal Cpk {cap.cpk_normal:.2f} ± {cap.cpk_normal_sigma:.2f}"
+        if cap.used == "percentile":
+            out.append(f"{_name(fs)}: {pct}; {cap.why}; {normal}: {cap.normal_note}")
+        else:
+            out.append(f"{_name(fs)}: {normal}; {cap.why}" + (f"; {cap.normal_note}" if cap.normal_note else "")
+                       + f"; {pct}")
+    return out
+
+
+def signal_lines(stats) -> list[str]:
+    """One line per figure whose control chart raised a run rule: each rule's (and side's) first unit and how often it
+    fired."""
+    out = []
+    for fs in stats.figures:
+        chart = getattr(fs, "chart", None)
+        if chart is None or not chart.signals:
+            continue
+        firsts = []
+        for key in dict.fromkeys((sg.rule, sg.side) for sg in chart.signals):
+            mine = [sg for sg in chart.signals if (sg.rule, sg.side) == key]
+            firsts.append(mine[0].describe() + (f", {len(mine)} times" if len(mine) > 1 else ""))
+        out.append(f"{_name(fs)}: " + "; ".join(firsts))
+    return out
+
+
+def _signal_note(stats) -> str:
+    n = max((fs.n for fs in stats.figures), default=0)
+    return ("(I-MR chart in lot order, limits from the lot's first units; Western Electric rules 1-4 (4: 8 in a row) and "
+            f"the moving range beyond D4 MR. An in-control lot of {n} units raises about {n / 50:.1f} false signals "
+            "per figure on these rules: a signal is a reason to look, not a verdict.)")
+
+
 def _stats_rows(stats) -> list[list]:
     rows = []
     for fs in stats.figures:
@@ -76,8 +134,7 @@ def _stats_rows(stats) -> list[list]:
         ref = fs.shown(fs.std)
         rows.append([fs.figure, fs.sensor, fs.job, fs.limit.describe() if fs.limit else "", fs.unit, fs.n,
                      _num(fs.shown(fs.mean), True, ref), _num(ref, False, ref), _num(fs.shown(fs.minimum), True, ref),
-                     _num(fs.shown(fs.maximum), True, ref),
-                     f"{fs.cpk:.2f} ± {fs.cpk_sigma:.2f}" if fs.limit and math.isfinite(fs.cpk_sigma) else "-",
+                     _num(fs.shown(fs.maximum), True, ref), _cpk_cell(fs),
                      f"{100 * fs.yield_:.1f} %" if fs.limit else "-", len(fs.outliers),
                      "-" if not math.isfinite(s) else
                      f"{_num(s, True, ss)} ± {_num(ss, False, ss)}" + (" *" if abs(s) > 3 * ss else "")])
@@ -104,7 +161,8 @@ def lot_summary(stats, source: str) -> str:
     for r in [header] + rows:
         lines.append("  ".join(c.ljust(w) if i < 5 else c.rjust(w) for i, (c, w) in enumerate(zip(r, widths))).rstrip())
     lines.append("(* a trend beyond 3 sigma; mean, std, min, max, trend in each figure's unit; populations by job, "
-                 "sensor and unit: counts apart from SI)")
+                 "sensor and unit: counts apart from SI; Cpk ± its standard error, or 'pct': the percentile Cpk "
+                 "[95 % interval] where normality is rejected)")
     bad = [u for u in stats.units if u.verdict != "pass"]
     if bad:
         lines += ["", f"units not passing ({len(bad)}):"]
@@ -116,6 +174,12 @@ def lot_summary(stats, source: str) -> str:
     if outliers:
         lines += ["", "outliers (robust z-score beyond 3.5): "
                   + ", ".join(f"{s} ({', '.join(f)})" for s, f in outliers.items())]
+    cap = capability_lines(stats)
+    if cap:
+        lines += ["", "capability (which Cpk is shown and why):"] + [f"  {c}" for c in cap]
+    sig = signal_lines(stats)
+    if sig:
+        lines += ["", "control-chart signals (first unit per rule):"] + [f"  {c}" for c in sig] + [_signal_note(stats)]
     return "\n".join(lines)
 
 
@@ -234,6 +298,11 @@ def control_charts_png(stats, start: int = 0) -> bytes:
             if math.isfinite(c):
                 ax.axhline(fs.shown(c), color="0.4", ls=":", lw=1)
         _limits(ax, fs, False)
+        chart = getattr(fs, "chart", None)
+        if chart is not None and chart.signals:
+            order = np.argsort(fs.x, kind="stable")
+            at = order[[sg.index for sg in chart.signals]]
+            ax.plot(fs.x[at], v[at], "x", color="tab:orange", ms=6)
         ax.set_title(f"{fs.figure} ({fs.sensor}, {fs.job})", fontsize=9)
         if ax is axes[0]:
             _legend(ax, fs, stats.spec is not None, ("mean", "k", "-"), ("control limits", "0.4", ":"))
@@ -275,12 +344,23 @@ def lot_report_html(stats, source: str) -> str:
                                 "its standard error; outliers by the robust z-score (beyond 3.5, from 8 units on); * a "
                                 "trend beyond 3 sigma. Each job, sensor and unit (counts or SI) is its own "
                                 "population.</p>"))
+        cap = capability_lines(stats)
+        if cap:
+            sections.append(Section("Capability", "<ul>" + "".join(f"<li>{esc(c)}</li>" for c in cap) + "</ul>"
+                                    + '<p class="note">Cpk shown: the normal one unless an Anderson-Darling test rejects '
+                                    "normality (alpha 0.05); then the percentile Cpk of ISO 22514-2 (each tail a Johnson "
+                                    "fit; 95 % percentile bootstrap interval).</p>"))
+        sig = signal_lines(stats)
+        if sig:
+            sections.append(Section("Control-chart signals", "<ul>" + "".join(f"<li>{esc(c)}</li>" for c in sig)
+                                    + "</ul>" + f'<p class="note">{esc(_signal_note(stats))}</p>'))
         starts = range(0, len(stats.figures), MAX_PANELS)
         sections.append(Section("Histograms", "".join(
             image(histograms_png(stats, k), "histogram of each figure with its limits") for k in starts)
             + f'<p class="note">All {len(stats.figures)} figures, {MAX_PANELS} per picture.</p>'))
         sections.append(Section("Control charts", "".join(
-            image(control_charts_png(stats, k), "individuals control charts") for k in starts)))
+            image(control_charts_png(stats, k), "individuals control charts") for k in starts)
+            + '<p class="note">Orange crosses: units where a run rule fired (see Control-chart signals).</p>'))
         outl = [[s, fs.figure, fs.sensor] for fs in stats.figures for s in fs.outliers]
         if outl:
             sections.append(Section("Outliers", table(["serial", "figure", "sensor"], outl, 3)))

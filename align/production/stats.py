@@ -42,10 +42,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from align.limits import Limit, Spec
 from align.production.capability import BOOTSTRAP, Capability, capability
 from align.production.control import ControlChart, control_chart
 from align.production.keyfigures import FIGURES, KIND, shown_unit, si_unit
-from align.production.spec import Limit, Spec
 from align.units import to_unit
 
 #: the robust z-score beyond which a unit is an outlier (Iglewicz and Hoaglin)
