@@ -220,7 +220,7 @@ def read_apply(options: ApplyOptions) -> ApplyInputs:
 
     where = str(options.alignment)
     sensor = None if options.sensor is None else Sensor.parse(options.sensor).value
-    correction = load_result(options.alignment).correction(sensor, where)
+    correction: Any = load_result(options.alignment).correction(sensor, where)
     kind = Sensor.parse(correction.sensor)
     typed, field = _typed_unit(options, kind)
     default = Sensor.GYROSCOPE.unit if kind is Sensor.GYROSCOPE else correction.units

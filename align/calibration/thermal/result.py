@@ -211,6 +211,11 @@ class ThermalCorrection:
         """The sensor it compensates."""
         return self.model.sensor
 
+    def correct(self, raw: np.ndarray) -> np.ndarray:
+        """Refused: a thermal correction needs the temperature of every sample (:meth:`compensate`)."""
+        raise InputError("a thermal calibration compensates the bias against temperature: give the log's "
+                         "temperature column with {temperature_column}")
+
     def compensate(self, raw: np.ndarray, temperature: np.ndarray, t: np.ndarray) -> Compensated:
         """``raw`` (n, 3), SI, compensated at ``temperature`` (n,), C, sampled at ``t`` (n,), s
         (:meth:`ThermalModel.compensate`)."""
