@@ -111,8 +111,9 @@ class Job(Generic[O, I, R]):
 
 
 def read_limits_of(options: Any) -> Any:
-    """The limits file an options value names in its ``limits`` field, read (:func:`align.limits.read_limits`);
-    None when it names none.
+    """The limits file an options value names in its ``limits`` field, read (:func:`align.limits.read_limits`), over
+    the options' own tolerances (``tolerance_limits()``, a limits table, when the options type has them); None when
+    there are neither.
 
     Raises
     ------
@@ -120,11 +121,16 @@ def read_limits_of(options: Any) -> Any:
         A limits file that cannot be read, naming it.
     """
     path = getattr(options, "limits", None)
-    if path is None:
+    own = options.tolerance_limits() if hasattr(options, "tolerance_limits") else {}
+    if path is None and not own:
         return None
-    from align.limits import read_limits
+    from align.io.files import read_toml
+    from align.limits import limits_from_dict
 
-    return read_limits(path)
+    if path is None:
+        return limits_from_dict(own, "the tolerances")
+    data = read_toml(path)  # the file's limits over the options' own (a tolerance the file also states: the file's)
+    return limits_from_dict({**{k: v for k, v in own.items() if k not in data}, **data}, str(path))
 
 
 def judged(result: Result, test: str, limits: Any = None) -> tuple:

@@ -57,6 +57,7 @@ KNOWN: dict[str, str] = {
     "imu-align.positions": "align.calibration.jobs.positions",
     "imu-align.warmup": "align.noise.warmup",
     "imu-align.repeatability": "align.noise.repeatability",
+    "imu-align.verification": "align.alignment.jobs.verify_job",
 }
 
 _TYPES: dict[str, type[Result]] = {}

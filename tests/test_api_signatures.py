@@ -11,7 +11,8 @@ CALLS = {"matrix": "MatrixOptions", "apply": "ApplyOptions", "allan": "AllanOpti
          "ferraris": "FerrarisOptions", "calibrate_accel": "AccelOptions", "calibrate_mag": "MagOptions",
          "calibrate_gyro": "GyroOptions", "budget": "BudgetOptions", "allowable": "AllowableOptions",
          "check": "CheckOptions", "drift": "DriftOptions", "calibrate_thermal": "ThermalOptions",
-         "calibrate_positions": "PositionsOptions", "warmup": "WarmupOptions", "repeatability": "RepeatabilityOptions"}
+         "calibrate_positions": "PositionsOptions", "warmup": "WarmupOptions", "repeatability": "RepeatabilityOptions",
+         "verify": "VerifyOptions"}
 
 
 @pytest.mark.parametrize("call", CALLS)

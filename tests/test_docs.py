@@ -25,7 +25,7 @@ MODULES = [
     "align.merit", "align.keyfigures", "align.limits", "align.judge",
     "align.calibration.jobs.positions", "align.calibration.multiposition",
     "align.noise.warmup", "align.noise.repeatability", "align.noise.bias_jobs",
-    "align.production.capability", "align.production.control",
+    "align.production.capability", "align.production.control", "align.alignment.jobs.verify_job",
     "align.provenance",
     "align.results",
     "align.api",

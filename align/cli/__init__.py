@@ -23,6 +23,7 @@ options    shared option types and their domains, the field -> flag table, old s
 paths      output checks before the work, the run's all-or-none outputs
 progress   the progress bar of long jobs
 alignment  matrix, apply
+verify     verify (a gyro correction replayed on a session it was not fitted to)
 simulate   simulate session | poses | lot | thermal | positions | warmup | turn-ons
 mechanics  budget, allowable, check
 noise      allan, plan
@@ -60,6 +61,7 @@ from align.cli import (
     parts,
     simulate,
     story,
+    verify,
 )
 from align.cli.options import rewrite_aliases, speller
 
@@ -89,7 +91,7 @@ def _root(
     pass
 
 
-_MODULES = (alignment, mechanics, parts, noise, bias, navigation, story, exports, batch, inspect)
+_MODULES = (alignment, verify, mechanics, parts, noise, bias, navigation, story, exports, batch, inspect)
 for _module in _MODULES:
     for _name, _command in _module.COMMANDS.items():
         app.command(_name)(_command)
