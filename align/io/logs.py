@@ -32,7 +32,7 @@ from align.io.formats import TIME_UNITS, LogFormat, time_unit
 from align.io.readings import celsius as _celsius
 from align.io.readings import sensor_scale
 from align.io.readings import units_of as _units_of
-from align.io.tables import read_columns, read_table, shown
+from align.io.tables import MissingColumns, read_columns, read_table, shown
 
 __all__ = ["read_sensor_log", "SensorLog", "read_log", "read_static_log", "StaticLog", "read_static", "read_columns",
            "sensor_scale", "NpyChunks", "check_finite", "check_readings", "check_time", "check_log", "MAX_READING"]
@@ -190,7 +190,14 @@ def read_sensor_log(path: str | Path, columns: list[str], units: str | None, tim
                              + ("; give {rate_hz} for a file without time" if use_time else ""), str(path))
         got = None
     else:
-        got = read_table(p, wanted, time_col, fmt)
+        try:
+            got = read_table(p, wanted, time_col, fmt)
+        except MissingColumns as e:
+            if e.missing != temp:
+                raise
+            raise InputError(f"no temperature column {shown(temperature_column)!r} (columns: {e.listed}); name it "
+                             "with {temperature_column}, or leave it out for a log without temperature",
+                             str(path)) from None
         data = got.data
     stated = got.unit(list(columns)) if got is not None else None
     units, from_file = _units_of(units, stated, default_units, expect, field, str(path))

@@ -290,5 +290,13 @@ def _require(names: list[str] | None, available: list[str], path, time_column: s
             advice = "name its time column with {time_column}, give {rate_hz} for a log without time, or " + advice
         hint = preamble_hint(Path(path), fmt) if fmt is not None else None
         listed = ", ".join(shown(a) for a in available) or "none"
-        raise InputError(f"no column {', '.join(repr(shown(m)) for m in missing)} (columns: {listed}); "
-                         + (hint or advice), str(path))
+        raise MissingColumns(f"no column {', '.join(repr(shown(m)) for m in missing)} (columns: {listed}); "
+                         + (hint or advice), str(path), missing, listed)
+
+
+class MissingColumns(InputError):
+    """A column asked for is not in the file: ``missing`` the names, ``listed`` the columns there are, shown."""
+
+    def __init__(self, message: str, where: str, missing: list[str], listed: str) -> None:
+        self.missing, self.listed = missing, listed
+        super().__init__(message, where)

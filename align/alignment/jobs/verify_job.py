@@ -147,6 +147,10 @@ def read_verify(options: VerifyOptions) -> VerifyInputs:
     if str(correction.sensor) != "gyroscope":
         raise InputError(f"corrects a {correction.sensor}; verify replays a gyro's correction on a rate-table "
                          "session (give its gyroscope with {sensor})", where)
+    if getattr(correction, "needs_temperature", False):
+        raise InputError("is a thermal calibration (bias against temperature); verify replays an alignment or a gyro "
+                         "calibration on a rate-table session: give one of those, or check a thermal result with "
+                         "apply on a held-out log", where)
     return VerifyInputs(read_matrix(options.matrix_options()), correction)
 
 

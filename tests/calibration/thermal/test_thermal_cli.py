@@ -119,3 +119,23 @@ def test_apply_compensates_a_log_with_its_thermal_result_against_the_simulated_t
         left = done[:, 1 + k] - (raw[:, 4 + k] - change)     # the compensation's error against the truth
         left -= np.median(left)                               # the constant: the reference bias, not compensated
         assert np.sqrt(np.mean(left**2)) < 0.25 * np.sqrt(np.mean((change - change.mean()) ** 2)), k
+    # a temperature column that is not there: the line names the temperature option, not the data columns'
+    out.unlink()
+    wrong = run_cli(*args, "--temperature-column", "tmp")
+    assert wrong.code == 2 and not out.exists() and len(wrong.err.strip().splitlines()) == 1
+    assert "no temperature column 'tmp'" in wrong.err and "--temperature-column" in wrong.err
+    assert "--columns" not in wrong.err
+
+
+def test_verify_refuses_a_thermal_result_naming_it(tmp_path, run_cli):
+    """verify replays a rate-table correction; a thermal result is refused in one line naming its file (not a flag
+    verify lacks)."""
+    sim, result = tmp_path / "chamber", tmp_path / "r.json"
+    assert run_cli("simulate", "thermal", sim, "--seed", "3").code == 0
+    assert run_cli("calibrate", "thermal", sim / "thermal.csv", "--temperature-column", "temperature", "--json",
+                   result).code == 0
+    assert run_cli("simulate", "session", tmp_path / "s").code == 0
+    got = run_cli("verify", result, tmp_path / "s" / "session.csv", "--plan", tmp_path / "s" / "plan.toml",
+                  "--sensor", "gyroscope")
+    assert got.code == 2 and len(got.err.strip().splitlines()) == 1 and "r.json" in got.err
+    assert "thermal calibration" in got.err and "--temperature-column" not in got.err
