@@ -32,7 +32,8 @@ parts      parts
 navigation drift
 story      report, demo
 exports    export
-batch      batch, lot
+batch      batch
+lot        lot
 calibrate  calibrate ferraris | accel | mag | gyro | thermal | positions
 inspect    inspect (what a log holds, before any job)
 """
@@ -55,6 +56,7 @@ from align.cli import (
     calibrate,
     exports,
     inspect,
+    lot,
     mechanics,
     navigation,
     noise,
@@ -91,7 +93,7 @@ def _root(
     pass
 
 
-_MODULES = (alignment, verify, mechanics, parts, noise, bias, navigation, story, exports, batch, inspect)
+_MODULES = (alignment, verify, mechanics, parts, noise, bias, navigation, story, exports, batch, lot, inspect)
 for _module in _MODULES:
     for _name, _command in _module.COMMANDS.items():
         app.command(_name)(_command)
