@@ -12,10 +12,15 @@ Measures, on the same lot:
   3. with --big, the slope of the batch's wall and CPU time over the lot's size (start-up taken out: the per-unit
      overhead, target < 10 %), and peak RSS (the largest process: the batch or one of its workers) with 200 and
      1,000 units (the 1,000-unit manifest lists the 200 sessions five times under other serials: the batch keeps
-     nothing per unit, so memory stays flat as the lot grows).
+     nothing per unit, so memory stays flat as the lot grows);
+  4. with --store 200,2000,10000, the results store as a line fills it: ``batch --workers 2`` on lots of each size
+     (throughput within 10 % of each other, peak RSS flat), then the largest lot run again into its full store (every
+     unit skipped): the whole rerun, and the resume's start (the journal folded, the store's keys read, the latest
+     row of each unit found) in-process (target < 2 s at 10,000 units).
 Every file is made in a temporary folder, removed at the end (also on a failure), unless --keep.
 
-    python bench/bench_batch.py [--units 200] [--big 1000] [--repeat 1] [--dask] [--keep DIR] [--no-bytecode]
+    python bench/bench_batch.py [--units 200] [--big 1000] [--repeat 1] [--dask] [--store 200,2000,10000]
+        [--keep DIR] [--no-bytecode]
 """
 
 from __future__ import annotations
@@ -164,6 +169,8 @@ def main() -> None:
     ap.add_argument("--big", type=int, default=1000, help="units of the memory run (0: skip)")
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--dask", action="store_true", help="also a local Dask cluster of 2 workers")
+    ap.add_argument("--store", type=str, default="", help="lot sizes of the store run, e.g. 200,2000,10000 (empty: "
+                    "skip); with it, the other runs are skipped unless --units is also given")
     ap.add_argument("--keep", type=Path, default=None, help="keep the lot and the outputs here")
     ap.add_argument("--no-bytecode", action="store_true", help=(
         "run the batches as this environment says (PYTHONDONTWRITEBYTECODE: every process compiles imu-align's "
@@ -180,6 +187,9 @@ def run(args: argparse.Namespace, folder: Path) -> None:
         os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
         os.environ["PYTHONPYCACHEPREFIX"] = str(folder / "pycache")
         batch(big_manifest(lot, 2), folder / "warm", 1)
+    if args.store:
+        store_run(lot, [int(x) for x in args.store.split(",")], folder)
+        return
     size = sum(p.stat().st_size for p in (lot.folder / "sessions").iterdir()) / 1e6
     rows = sum(1 for _ in open(lot.folder / "sessions" / "SN0001.csv")) - 1
     print(f"lot: {args.units} units, {rows} rows each (6 dwells of 10 s at 200 Hz), {size:.0f} MB of CSV, "
@@ -238,6 +248,50 @@ def run(args: argparse.Namespace, folder: Path) -> None:
         m2 = max(x.rss for x in runs[2])
         print(f"batch of {args.big} units, --workers 2: {bb.wall:6.2f} s  {args.big / bb.wall:6.2f} units/s  peak RSS "
               f"{bb.rss:6.1f} MB (vs {m2:.1f} MB for {n}: {'flat' if bb.rss < 1.15 * m2 else 'GROWS'})")
+
+
+_RESUME = (
+    "import sys, time\n"
+    "t0 = time.perf_counter()\n"
+    "from align.production.batch import TABLE\n"
+    "from align.production.store import Journal, read_table\n"
+    "from align.production.table import META, latest_rows\n"
+    "from pathlib import Path\n"
+    "t1 = time.perf_counter()\n"
+    "store = Path(sys.argv[1]) / TABLE\n"
+    "Journal(store).recover()\n"
+    "rows = latest_rows(read_table(store, [n for n, _ in META]))\n"
+    "print(len(rows), t1 - t0, time.perf_counter() - t1)\n"
+)
+
+
+def store_run(lot, sizes: list[int], folder: Path) -> None:
+    """Throughput and peak RSS of ``batch --workers 2`` on lots of ``sizes`` units (each into a fresh store), then
+    the largest run again into its store: every unit skipped (the whole rerun, and the resume's start)."""
+    from align.production.store import read_table
+
+    rates, steady = {}, {}
+    for n in sizes:
+        b = batch(big_manifest(lot, n), folder / "out", 2, tag=f"store{n}")
+        stamps = sorted(read_table(folder / "out" / f"w2-store{n}" / "results.parquet", ["time"]).column("time")
+                        .cast("int64").to_pylist())  # when each unit's row was made, microseconds
+        rates[n], steady[n] = n / b.wall, (n - 1) / ((stamps[-1] - stamps[0]) / 1e6)
+        print(f"store: {n:6d} units, batch --workers 2: {b.wall:7.2f} s  {rates[n]:6.2f} units/s (start-up "
+              f"included), {steady[n]:6.2f} units/s from the first unit's row to the last's; peak RSS {b.rss:6.1f} MB",
+              flush=True)
+    for name, r in (("whole", rates), ("steady", steady)):
+        lo, hi = min(r.values()), max(r.values())
+        print(f"store: {name} throughput {lo:.2f} to {hi:.2f} units/s, spread {100 * (hi / lo - 1):.1f} % "
+              "(target within 10 %)")
+    n = max(sizes)
+    out = folder / "out" / f"w2-store{n}"
+    again = run_tree([sys.executable, "-m", "align.cli", "batch", str(lot.folder / f"manifest{n}.csv"), "--workers",
+                      "2", "--out", str(out)])
+    got = subprocess.run([sys.executable, "-c", _RESUME, str(out)], capture_output=True, text=True, check=True)
+    count, imports, start = got.stdout.split()
+    print(f"store: rerun of {n} units (every unit skipped: inputs hashed, nothing run): {again.wall:.2f} s, peak RSS "
+          f"{again.rss:.1f} MB; the resume's start (journal, the store's keys, {count} latest rows): {float(start):.3f} s "
+          f"(+ {float(imports):.2f} s of imports; target < 2 s)")
 
 
 def _best(runs: list[Run]) -> Run:

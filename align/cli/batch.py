@@ -92,7 +92,7 @@ def batch(
     from align.present.lot import batch_summary
     from align.production import TABLE, BatchRun, judge_rows, make_pool, plan_tasks, read_manifest, read_spec, run_units
     from align.production.batch import locked
-    from align.production.stats import rejudge_rows
+    from align.production.stats import figures_needed, rejudge_rows
     from align.production.table import now
 
     if scheduler is not None and scheduler != "local" and workers is not None:
@@ -115,7 +115,8 @@ def batch(
         try:
             with locked(folder):
                 tasks, skipped = plan_tasks(lot.units, folder, _task_maker(lot.folder.resolve(), prepared),
-                                            now().isoformat(), rerun=rerun)
+                                            now().isoformat(), rerun=rerun,
+                                            figures=figures_needed(limits) if limits is not None else ())
                 run.add(rejudge_rows(skipped, limits), skipped=True)  # judged again: the spec may be another
                 if tasks:
                     with pool, progress(len(tasks), "units") as tick:

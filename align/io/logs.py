@@ -193,9 +193,9 @@ def read_sensor_log(path: str | Path, columns: list[str], units: str | None, tim
         try:
             got = read_table(p, wanted, time_col, fmt)
         except MissingColumns as e:
-            if e.missing != temp:
+            if not temp or e.missing != temp:
                 raise
-            raise InputError(f"no temperature column {shown(temperature_column)!r} (columns: {e.listed}); name it "
+            raise InputError(f"no temperature column {shown(temp[0])!r} (columns: {e.listed}); name it "
                              "with {temperature_column}, or leave it out for a log without temperature",
                              str(path)) from None
         data = got.data

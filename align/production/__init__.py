@@ -5,7 +5,8 @@ units and looks at them together. This package holds everything but the jobs the
 
 manifest   which units, with which job, inputs and options; the content hash of a unit's inputs
 figures    the key figures of a result, one flat row per sensor (SI)
-table      the lot's Parquet table, appended through a journal
+table      the lot's table: its schema and rows
+store      the table's files: a folder of Parquet parts appended through a journal, read lazily
 pools      where units run: a process pool, or a Dask cluster (optional extra)
 batch      the batch: tasks, skipping what is done, running the rest, journaling
 spec       limits per figure (TOML, units at the edge)
@@ -41,7 +42,8 @@ from align.production.manifest import Manifest, Unit, input_hash, read_manifest
 from align.production.pools import make_pool
 from align.production.rehearsal import LotSpread, LotTruth, simulate_lot
 from align.production.stats import FigureStats, LotStats, judge_rows, lot_statistics
-from align.production.table import SCHEMA, Journal, append_rows, latest_rows, read_table
+from align.production.store import Journal, append_rows, read_table
+from align.production.table import SCHEMA, latest_rows
 
 __all__ = ["TABLE", "UNITS", "BatchRun", "Task", "error_rows", "plan_tasks", "run_units", "run_job", "unit_rows",
            "result_unit_rows", "FIGURES", "result_rows", "Manifest", "Unit", "input_hash", "read_manifest", "make_pool",

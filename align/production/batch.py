@@ -34,9 +34,10 @@ from typing import Any
 from align.errors import AlignError, InputError
 from align.production.keyfigures import result_rows
 from align.production.manifest import Unit, input_hash
-from align.production.table import Journal, latest_rows, now, read_table
+from align.production.store import Journal, read_table
+from align.production.table import META, latest_rows, now
 
-#: the table's file name in the output folder
+#: the store's name in the output folder (a folder of Parquet parts, :mod:`align.production.store`)
 TABLE = "results.parquet"
 #: the folder of the units' result files in the output folder
 UNITS = "units"
@@ -130,7 +131,7 @@ class BatchRun:
 def _base(task: Task) -> dict:
     u = task.unit
     return {"serial": u.serial, "slot": u.slot, "order": u.order, "run": task.run, "job": u.job,
-            "result": str(task.result), "worker": socket.gethostname() + f":{os.getpid()}"}
+            "result": str(task.result), "worker": socket.gethostname() + f":{os.getpid()}", **dict(u.identity)}
 
 
 def error_rows(task: Task, status: str, exit_code: int, message: str, digest: str | None = None,
@@ -221,7 +222,7 @@ def run_job(task: Task, files: Callable | None = None,
 
 
 def plan_tasks(units: Iterable[Unit], out: Path, make: Callable[[Unit, Path, str], Task],
-               run: str, rerun: bool = False) -> tuple[list[Task], list[dict]]:
+               run: str, rerun: bool = False, figures: Iterable[str] = ()) -> tuple[list[Task], list[dict]]:
     """The tasks to run, and the table's latest rows of the units to skip (see the module docstring), the
     journal of a killed run folded first.
 
@@ -236,11 +237,15 @@ def plan_tasks(units: Iterable[Unit], out: Path, make: Callable[[Unit, Path, str
         This run's id.
     rerun : bool
         Run every unit, skipping none.
+    figures : iterable of str
+        The figures to read of the skipped units' rows (a spec judges them again); the store's other figure
+        columns are not read.
     """
     table_path = out / TABLE
     Journal(table_path).recover()
     last: dict[tuple[str, str], list[dict]] = {}
-    for r in latest_rows(read_table(table_path)):
+    figures = list(figures)
+    for r in latest_rows(read_table(table_path, [n for n, _ in META] + figures), figures):
         last.setdefault((r["serial"], r["job"]), []).append(r)
     tasks = [(unit, make(unit, out / UNITS / unit.result_name, run)) for unit in units]
     done = [] if rerun else [(unit, task) for unit, task in tasks if task.result.exists()

@@ -10,7 +10,10 @@ optional ``[defaults]`` table whose keys every unit takes unless it states its o
 Columns: ``serial`` (names the unit's result file: letters, digits, ``.``, ``_``, ``-``), ``job``
 (a command of the single-unit tool), ``log``, ``plan`` (empty where the job has none), ``options``
 (the single command's options as typed, split as a POSIX shell splits them; ``{serial}`` in them
-becomes the unit's serial), and optionally ``slot`` (the fixture slot). Paths are relative to the
+becomes the unit's serial), and optionally ``slot`` (the fixture slot) and the unit's identity: ``station``,
+``fixture``, ``operator``, ``device_id`` (the sensor's own id, as its log or label states it) and ``test_time``
+(when it was tested, ISO 8601 with its zone: ``2026-11-28T14:05:00+01:00`` or ``...Z``; a trend over test time
+needs it, the table's ``time`` being when the row was made). Paths are relative to the
 manifest's folder. A bad manifest is one :class:`~align.errors.InputError` naming the file, the
 row (CSV line or ``[[unit]]`` number) and the column.
 
@@ -18,7 +21,7 @@ The content hash of a unit's inputs (:func:`input_hash`) decides whether a rerun
 
 Public names
 ------------
-Unit, Manifest, read_manifest, input_hash, PLAN_USE, SERIAL
+Unit, Manifest, read_manifest, input_hash, PLAN_USE, SERIAL, IDENTITY
 """
 
 from __future__ import annotations
@@ -31,6 +34,7 @@ import re
 import shlex
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
+from datetime import datetime
 from pathlib import Path
 
 from align.errors import InputError, literal
@@ -42,7 +46,9 @@ PLAN_USE = ("required", "optional", "none")
 SERIAL = re.compile(r"^[A-Za-z0-9_-][A-Za-z0-9._-]{0,127}$")
 #: the columns of a manifest: required ones, then optional ones
 REQUIRED = ("serial", "job", "log")
-OPTIONAL = ("plan", "options", "slot")
+OPTIONAL = ("plan", "options", "slot", "station", "fixture", "operator", "device_id", "test_time")
+#: the optional columns that identify how the unit was tested (carried into its rows of the lot's table)
+IDENTITY = ("station", "fixture", "operator", "device_id", "test_time")
 
 
 @dataclass(frozen=True)
@@ -68,6 +74,8 @@ class Unit:
         Position in the manifest, from 0 (the lot's order for trends).
     row : str
         Where the unit is stated, for messages: ``"line 4"`` (CSV) or ``"[[unit]] 3"`` (TOML).
+    identity : tuple of (str, str)
+        The identity columns given (:data:`IDENTITY`), ``test_time`` as ISO 8601 with its zone.
     """
 
     serial: str
@@ -78,6 +86,7 @@ class Unit:
     slot: str | None
     order: int
     row: str
+    identity: tuple[tuple[str, str], ...] = ()
 
     @property
     def result_name(self) -> str:
@@ -192,8 +201,11 @@ def _toml_records(path: Path) -> list[tuple[str, dict]]:
                                  str(path))
             if key == "options" and isinstance(value, list) and all(isinstance(v, str) for v in value):
                 merged[key] = shlex.join(value)
-            elif isinstance(value, (int, float)) and not isinstance(value, bool) and key in ("serial", "slot"):
+            elif isinstance(value, (int, float)) and not isinstance(value, bool) and key in ("serial", "slot",
+                                                                                            "device_id"):
                 merged[key] = str(value)
+            elif key == "test_time" and isinstance(value, datetime):  # a TOML date-time
+                merged[key] = value.isoformat()
             elif not isinstance(value, str):
                 raise InputError(f"{row}, column {key}: give a string (got {literal(repr(value))})", str(path))
         records.append((row, {k: v.strip() for k, v in merged.items()}))
@@ -228,7 +240,27 @@ def _unit(record: dict, row: str, order: int, folder: Path, jobs: Mapping[str, s
         raise bad("options", f"cannot be split ({exc}); check the quotes") from None
     slot = record.get("slot") or None
     return Unit(serial, job, (folder / log).resolve(), (folder / plan).resolve() if plan else None, options, slot,
-                order, row)
+                order, row, _identity(record, bad))
+
+
+def _identity(record: dict, bad) -> tuple[tuple[str, str], ...]:
+    """The identity columns given; ``test_time`` checked as ISO 8601 with a zone."""
+    out = []
+    for key in IDENTITY:
+        value = record.get(key) or ""
+        if not value:
+            continue
+        if key == "test_time":
+            try:
+                stamp = datetime.fromisoformat(value)
+            except ValueError:
+                raise bad(key, f"'{literal(value)}' is not an ISO 8601 time; give e.g. 2026-11-28T14:05:00+01:00") from None
+            if stamp.tzinfo is None:
+                raise bad(key, f"'{literal(value)}' states no zone; add it (+01:00, or Z for UTC) so that the lot's "
+                          "trend over test time is not shifted")
+            value = stamp.isoformat()
+        out.append((key, value))
+    return tuple(out)
 
 
 def input_hash(job: str, options: Iterable[str], files: Iterable[Path | None],

@@ -17,7 +17,7 @@ from align.errors import InputError
 from align.production import lot_statistics, read_spec
 from align.production.manifest import input_hash
 from align.production.stats import wilson
-from align.production.table import Journal, append_rows, read_table
+from align.production.store import Journal, append_rows, read_table
 from align.units import DEG
 
 T0 = datetime(2026, 1, 1, tzinfo=UTC)

@@ -107,7 +107,7 @@ def test_a_rerun_skips_the_units_done_with_unchanged_inputs_and_leaves_no_thread
     from datetime import UTC, datetime
 
     from align.production import plan_tasks
-    from align.production.table import append_rows
+    from align.production.store import append_rows
 
     tasks = _tasks(tmp_path, 6)
     for k, t in enumerate(tasks):

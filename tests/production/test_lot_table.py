@@ -1,7 +1,9 @@
-"""The lot's table: one Parquet file appended atomically, read back as one table by pandas and pyarrow."""
+"""The lot's store: a folder of Parquet parts appended without rewriting, read back as one table by pandas, pyarrow
+and DuckDB; a store of one file (before 0.3) read as it is and moved into the folder on the first append."""
 
 from __future__ import annotations
 
+import json
 import math
 from datetime import UTC, datetime, timedelta
 
@@ -23,31 +25,66 @@ def _row(serial, minutes, run="r1", phi=0.001, status="ok", sensor="gyroscope"):
             "arw_x": math.nan}
 
 
+def _parts(path):
+    return sorted(p.relative_to(path) for p in path.rglob("*") if p.is_file())
+
+
 def test_appends_make_one_table_every_reader_takes_as_it_is(tmp_path):
     path = tmp_path / "results.parquet"
     assert append_rows(path, [_row("U1", 0), _row("U2", 1)]) == 2
+    first = _parts(path)
+    before = (path / first[0]).read_bytes()
     assert append_rows(path, [_row("U1", 60, "r2", phi=0.002)]) == 1
     assert append_rows(path, []) == 0
-    df = pd.read_parquet(path)  # pandas: one file, one table
+    parts = _parts(path)
+    assert len(parts) == 2 and first[0] in parts and (path / first[0]).read_bytes() == before  # nothing rewritten
+    assert all(p.parts[0].startswith("date=20") and p.name.startswith("part-") for p in parts)  # Hive: by day
+    df = pd.read_parquet(path).sort_values(["time"])  # pandas: the folder is one table (plus the partition `date`)
     assert len(df) == 3 and list(df.columns[:3]) == ["serial", "slot", "order"]
     assert set(FIGURES) <= set(df.columns) and df.phi_xy.tolist() == [0.001, 0.001, 0.002]
     assert df.arw_x.isna().all() and str(df.time.dt.tz) == "UTC"
     assert ds.dataset(path).to_table().num_rows == 3  # a dataset reader too
-    meta = pq.read_schema(path)
+    meta = pq.read_schema(path / parts[0])
     assert meta.field("phi_xy").metadata[b"unit"] == b"rad" and meta.metadata[b"format"] == b"imu-align.lot-table"
-    assert not [p for p in tmp_path.iterdir() if p.name != "results.parquet"]  # no temporary left
+    assert [p.name for p in tmp_path.iterdir()] == ["results.parquet"]  # no temporary left
     latest = latest_rows(read_table(path))
     assert [(r["serial"], r["run"]) for r in latest] == [("U1", "r2"), ("U2", "r1")]
+    keys = read_table(path, ["serial", "run", "no_such_column"])  # a resume reads its keys alone
+    assert keys.column_names == ["serial", "run"] and keys.num_rows == 3
+
+
+def test_duckdb_query_on_the_store(tmp_path):
+    duckdb = pytest.importorskip("duckdb")
+    path = tmp_path / "results.parquet"
+    append_rows(path, [_row("U1", 0), _row("U2", 1)])
+    append_rows(path, [_row("U1", 60, "r2", phi=0.002)])
+    got = duckdb.sql(f"SELECT serial, max(phi_xy) FROM read_parquet('{path}/**/*.parquet', union_by_name = true) "
+                     "GROUP BY serial ORDER BY serial").fetchall()
+    assert got == [("U1", 0.002), ("U2", 0.001)]
+
+
+def test_a_store_of_one_file_is_read_as_it_is_and_moved_whole_on_the_first_append(tmp_path):
+    from align.production.table import SCHEMA, _clean, _table
+
+    path = tmp_path / "results.parquet"
+    pq.write_table(_table([_clean(_row("U1", 0))]).replace_schema_metadata(SCHEMA.metadata), path)
+    old = path.read_bytes()
+    assert [r["serial"] for r in latest_rows(read_table(path))] == ["U1"]  # read as it is, untouched
+    assert path.is_file() and path.read_bytes() == old
+    append_rows(path, [_row("U2", 1)])
+    assert path.is_dir() and old in [(path / p).read_bytes() for p in _parts(path)]
+    assert sorted(r["serial"] for r in latest_rows(read_table(path))) == ["U1", "U2"]
 
 
 def test_a_table_with_a_column_this_release_does_not_know_keeps_it(tmp_path):
     path = tmp_path / "results.parquet"
     append_rows(path, [_row("U1", 0)])
+    part = path / _parts(path)[0]
     newer = read_table(path).append_column("temperature", pa.array([21.5]))
-    pq.write_table(newer, path)
+    pq.write_table(newer, part)
     append_rows(path, [_row("U2", 1)])
-    df = pd.read_parquet(path)
-    assert df.temperature.tolist()[0] == 21.5 and math.isnan(df.temperature.tolist()[1])
+    got = read_table(path)
+    assert got.column("temperature").to_pylist() == [21.5, None]
 
 
 def test_the_journal_of_a_killed_run_is_folded_into_the_table(tmp_path):
@@ -61,6 +98,9 @@ def test_the_journal_of_a_killed_run_is_folded_into_the_table(tmp_path):
     assert not path.exists()
     assert Journal(path).recover() == 3
     assert not journal.path.exists()
+    with open(journal.path, "w") as fh:  # a kill after the part's rename, before the journal's removal
+        fh.write(json.dumps({**_row("U1", 0), "time": T0.isoformat()}) + "\n")
+    assert Journal(path).recover() == 0 and read_table(path).num_rows == 3
     df = pd.read_parquet(path)
     assert df.serial.tolist() == ["U1", "U2", "U2"] and df.time.iloc[0] == pd.Timestamp(T0)
 
@@ -70,8 +110,16 @@ def test_a_file_that_is_not_a_table_is_one_error(tmp_path):
     bad.write_text("serial,job\n")
     with pytest.raises(InputError, match="results.parquet: not a readable Parquet table"):
         read_table(bad)
-    with pytest.raises(InputError, match="is a folder"):
-        read_table(tmp_path)
+    (tmp_path / "other").mkdir()
+    (tmp_path / "other" / "notes.txt").write_text("x")
+    with pytest.raises(InputError, match="other: holds no Parquet part of a lot"):
+        read_table(tmp_path / "other")
+    store = tmp_path / "store"
+    append_rows(store, [_row("U1", 0)])
+    (store / "date=2026-01-01").mkdir()
+    (store / "date=2026-01-01" / "part-x.parquet").write_text("not parquet")
+    with pytest.raises(InputError, match="store: part-x.parquet: not a readable Parquet table"):
+        read_table(store)
 
 
 def test_rows_are_built_as_pyarrow_builds_them_from_python_objects(tmp_path):
@@ -85,7 +133,7 @@ def test_rows_are_built_as_pyarrow_builds_them_from_python_objects(tmp_path):
     assert _table(clean).equals(pa.Table.from_pylist(clean, schema=SCHEMA))
     path = tmp_path / "results.parquet"
     append_rows(path, rows)
-    back = pq.read_table(path)
+    back = pq.read_table(path / _parts(path)[0])
     assert back.column("time").to_pylist() == pa.Table.from_pylist(clean, schema=SCHEMA).column("time").to_pylist()
     assert back.column("message").to_pylist()[1] == "naïve µ" and back.column("phi_xy").to_pylist()[3] is None
     with pytest.raises(TypeError, match="column serial"):
