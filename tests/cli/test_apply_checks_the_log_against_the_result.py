@@ -201,3 +201,41 @@ def test_the_corrected_csv_states_its_units_and_reads_back_with_them(run_cli, tm
     assert np.abs(m - np.eye(3)).max() < 1e-6   # its 1-sigma is 1.5e-5
     res = run_cli("matrix", out, "--plan", root / "plan.toml", "--gyro-units", "rad/s")
     assert res.code == 2 and "states its readings in deg/s" in res.err and len(res.err.splitlines()) == 1
+
+
+def _static_log(folder, name, bias, factor, seed):
+    """A still unit of MODEL (Earth's rate left out) whose bias is ``bias`` (rad/s), written as rad/s times
+    ``1 / factor`` (``factor`` the SI size of the unit written: DEG for deg/s, 1 for rad/s)."""
+    rng = np.random.default_rng(seed)
+    n, fs = 4000, 200.0
+    g = (MODEL.M @ np.zeros(3) + bias)[None, :] + rng.normal(0.0, 0.05 * DEG, (n, 3))
+    log = folder / name
+    write_csv(log, ["time", "gyro_x", "gyro_y", "gyro_z"], np.column_stack([np.arange(n) / fs, g / factor]))
+    return log
+
+
+def test_a_rad_s_log_read_as_deg_s_is_refused_by_the_bias_at_rest(tmp_path, run_cli, aligned):
+    """Issue 28: "a rad/s log gets a deg/s bias subtracted". The log states no unit; at rest it reads the unit's
+    bias (MODEL's 0.5, -0.4, 0.3 deg/s) divided by 57.3 when read as deg/s, and the line says so and names rad/s."""
+    log = _static_log(tmp_path, "rad.csv", MODEL.bias, 1.0, 1)
+    out = tmp_path / "out.csv"
+    line = one_line(run_cli("apply", log, "--alignment", aligned, "--out", out))
+    assert "is the log in rad/s? give it with --gyro-units rad/s" in line and not out.exists()
+    res = run_cli("apply", log, "--alignment", aligned, "--gyro-units", "rad/s", "--out", out)
+    assert res.code == 0, res.err
+    done = np.loadtxt(out, delimiter=",", skiprows=2)[:, 1:]
+    assert np.abs(done.mean(axis=0)).max() < 0.01  # rad/s: corrected to rest
+
+
+@pytest.mark.parametrize("change", [0.0, 0.3, 0.8])
+def test_a_deg_s_log_whose_bias_moved_since_is_not_refused(tmp_path, run_cli, aligned, change):
+    """No false alarm: the same unit turned on again, its bias moved by up to 80 % of itself (a turn-on's change
+    or temperature), read in its own unit, is corrected (the moved bias is what remains at rest)."""
+    moved = MODEL.bias + change * np.array([-1.0, 0.5, 1.0]) * np.abs(MODEL.bias)
+    log = _static_log(tmp_path, "deg.csv", moved, DEG, 2)
+    out = tmp_path / "out.csv"
+    res = run_cli("apply", log, "--alignment", aligned, "--out", out)
+    assert res.code == 0, res.err
+    done = np.loadtxt(out, delimiter=",", skiprows=2)[:, 1:]
+    want = np.linalg.solve(MODEL.M, moved - MODEL.bias) / DEG
+    assert np.allclose(done.mean(axis=0), want, atol=0.02)

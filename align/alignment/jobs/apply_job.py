@@ -5,7 +5,7 @@
 
 Public names
 ------------
-MAX_GYRO_RATE, STILL_RATE_MAX, ApplyOptions, ApplyInputs, read_apply, compute_apply, apply_input_files, APPLY,
+MAX_GYRO_RATE, STILL_RATE_MAX, BIAS_CHECKED, ApplyOptions, ApplyInputs, read_apply, compute_apply, apply_input_files, APPLY,
 apply, CorrectedLog
 """
 
@@ -27,13 +27,17 @@ from align.job import Job, Progress, fields_signature
 from align.units import DEG_S, DIMENSIONS, parse_unit
 from align.vocab import Sensor
 
-__all__ = ["MAX_GYRO_RATE", "STILL_RATE_MAX", "ApplyOptions", "ApplyInputs", "read_apply", "compute_apply",
+__all__ = ["MAX_GYRO_RATE", "STILL_RATE_MAX", "BIAS_CHECKED", "ApplyOptions", "ApplyInputs", "read_apply", "compute_apply",
            "apply_input_files", "APPLY", "apply", "CorrectedLog"]
 
 #: the largest rate a MEMS gyro reads, rad/s: beyond the +/-4000 deg/s full scale of the fastest parts
 MAX_GYRO_RATE = 5000 * DEG_S
 #: the largest rate a gyro reads while still (corrected), rad/s: zero-rate offsets of MEMS gyros stay well within it
 STILL_RATE_MAX = 50 * DEG_S
+#: the smallest rest reading of a correction (its bias, ``|A b|``) against which a log's unit is judged at rest
+BIAS_CHECKED = 0.05 * DEG_S
+#: rate units a log is often mistaken for (another's factor is a ratio of theirs)
+_RATE_UNITS = ("rad/s", "deg/s", "mdps")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -182,6 +186,31 @@ def _check_gyro(got: SensorLog, correction: Any, unit: str, field: str, where: s
         raise UnitError(f"corrected, its stillest stretches read at least {rest.min() / DEG_S:.4g} deg/s, beyond the "
                         f"{STILL_RATE_MAX / DEG_S:.0f} deg/s any MEMS gyro reads at rest: {fix} (or the log holds no "
                         "moment at rest)", where)
+    _check_bias_at_rest(still, correction, unit, field, where)
+
+
+def _check_bias_at_rest(still: np.ndarray, correction: Any, unit: str, field: str, where: str) -> None:
+    """At rest a log read in its own unit reads about the correction's bias, so that the corrected rest is small
+    against the bias removed, ``|A (g_rest - b)| << |A b|``; a log in another unit (rad/s read as deg/s) reads
+    ``g_rest = b / k`` and its corrected rest is about ``-A b``. Refused when the corrected rest is over half the
+    bias removed while the log read at one of the usual other units (:data:`_RATE_UNITS`) corrects to a fifth of
+    it or less; nothing is judged for a bias under :data:`BIAS_CHECKED` (a turn-on's change of bias, Earth's rate)."""
+    if not len(still):
+        return
+    removed = float(np.linalg.norm(np.asarray(correction.correct(np.zeros((1, 3))), float)))
+    if removed < BIAS_CHECKED:
+        return
+    rest = float(np.linalg.norm(correction.correct(still), axis=1).min())
+    if rest <= 0.5 * removed:
+        return
+    factor = parse_unit(unit).factor
+    for other in _RATE_UNITS:
+        k = parse_unit(other).factor / factor
+        if not math.isclose(k, 1.0, rel_tol=1e-6) and \
+                float(np.linalg.norm(correction.correct(still * k), axis=1).min()) <= 0.2 * removed:
+            raise UnitError(f"read in {literal(unit)}, it reads at rest {rest / DEG_S:.3g} deg/s away from the bias the "
+                            f"result removes ({removed / DEG_S:.3g} deg/s), and read in {other} it would match it: is "
+                            f"the log in {other}? give it with {{{field}={other}}}", where)
 
 
 def _check_mag(got: SensorLog, correction: Any, corrected: np.ndarray, unit: str, field: str, where: str) -> None:
