@@ -218,7 +218,7 @@ def warmup(*, log: str | Path | LogSource, progress: Progress | None = None, **f
     >>> path = Path(tempfile.mkdtemp()) / "rec.npy"
     >>> np.save(path, simulate_warmup(600.0, 10.0, [1e-3], [4e-3], 30.0, 1e-4, seed=1)[1])
     >>> res = warmup(log=path, columns="gyro_x", rate_hz=10.0, gyro_units="rad/s", window=5.0, band=1e-4)
-    >>> bool(abs(res.channels[0].time - 30 * np.log(40)) < 0.1 * 30 * np.log(40)), res.figures()[0].name
+    >>> bool(abs(res.channels[0].time - 30 * np.log(40)) < 0.1 * 30 * np.log(40)), res.figures_of_merit()[0].name
     (True, 'warmup_x')
     """
     from align.noise.jobs import _from_sources

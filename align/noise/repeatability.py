@@ -286,12 +286,8 @@ class RepeatabilityResult(Result, format=REPEATABILITY_FORMAT, convention=CONVEN
         return (f"std (ddof 1) of the biases of {len(self.runs)} turn-ons (IEEE Std 952/1431 turn-on to turn-on), "
                 f"{100 * self.level:g} % chi-square interval; bias = mean after warm-up ({self.skip_rule})")
 
-    def figures(self) -> tuple[Figure, ...]:
-        """``bias_repeatability_x..`` of the first three channels, with the interval and the estimation noise said."""
-        return self.figures_of_merit()
-
     def figures_of_merit(self) -> tuple[Figure, ...]:
-        """The figures (:meth:`figures`)."""
+        """``bias_repeatability_x..`` of the first three channels, with the interval and the estimation noise said."""
         vals = []
         for j in range(min(3, len(self.names))):
             note = f"{100 * self.level:g} % interval [{self.low[j]:.4g}, {self.high[j]:.4g}] {self.unit}"

@@ -365,12 +365,8 @@ class WarmupResult(Result, format=WARMUP_FORMAT, convention=CONVENTION):
         """SI unit of the readings."""
         return "rad/s" if self.sensor == "gyroscope" else "m/s^2"
 
-    def figures(self) -> tuple[Figure, ...]:
-        """``warmup_x..`` (s) of the first three channels; NaN (with the reason) when not settled."""
-        return self.figures_of_merit()
-
     def figures_of_merit(self) -> tuple[Figure, ...]:
-        """The figures (:meth:`figures`)."""
+        """``warmup_x..`` (s) of the first three channels; NaN (with the reason) when not settled."""
         vals = [(c.time, c.sigma, "" if c.settled else c.note) for c in self.channels[:3]]
         return channel_figures("warmup", self.sensor, vals, "s", self.criterion, "warmup")
 

@@ -152,7 +152,7 @@ def test_six_positions_report_scale_and_g_sensitivity_as_not_observable():
                 v, s, st = g.param(kind, i, j)
                 assert st == "not observable" and math.isnan(v) and math.isnan(s)
     res = PositionsResult(fit.gyroscope, fit.accelerometer, LAT, G, ())
-    figs = {(f.sensor, f.name): f for f in res.figures()}
+    figs = {(f.sensor, f.name): f for f in res.figures_of_merit()}
     names = [f"scale_{a}" for a in "xyz"] + [f"phi_{a}{b}" for a in "xyz" for b in "xyz" if a != b]
     for name in names + [f"gsens_{a}{b}" for a in "xyz" for b in "xyz"]:
         f = figs[("gyroscope", name)]
@@ -314,11 +314,11 @@ def test_a_rate_table_m_makes_the_bias_of_a_lopsided_design_observable(tmp_path)
     t = truth(rng)
     log, pos = write_session(tmp_path, LOPSIDED, t, rng, gyro_sd=2e-5)
     free = POSITIONS.run(PositionsOptions(log=LogSource(path=log), positions=pos))
-    figs = {f.name: f for f in free.figures() if f.sensor == "gyroscope"}
+    figs = {f.name: f for f in free.figures_of_merit() if f.sensor == "gyroscope"}
     assert math.isnan(figs["bias_x"].value) and figs["bias_x"].detail == "not observable from these positions"
     table = tmp_path / "table.json"
     cal = Calibration("gyroscope", t["M_g"], np.zeros(3), np.zeros((3, 3)), np.zeros(3), "rad/s", "rate table")
     align.results.save_result(table, CalibrationSet({"gyroscope": cal}))
     known = POSITIONS.run(PositionsOptions(log=LogSource(path=log), positions=pos, frame=table))
     assert max(abs(z) for z in z_scores(known, "b", "gyroscope", t)) < 3.5
-    assert not any(f.name.startswith("scale_") for f in known.figures() if f.sensor == "gyroscope")
+    assert not any(f.name.startswith("scale_") for f in known.figures_of_merit() if f.sensor == "gyroscope")

@@ -68,7 +68,7 @@ def test_warmup_result_states_its_criterion_figures_and_file(tmp_path):
     np.save(path, turn_on_record(7))
     res = warmup(log=path, rate_hz=FS, gyro_units="rad/s", window=20.0, band="0.0114592 deg/s")  # 2e-4 rad/s
     assert res.channels[0].band == pytest.approx(BAND, rel=1e-5)
-    figs = res.figures()
+    figs = res.figures_of_merit()
     assert [f.name for f in figs] == ["warmup_x", "warmup_y", "warmup_z"]
     assert all(f.unit == "s" and f.sensor == "gyroscope" and "20 s moving mean" in f.method for f in figs)
     assert figs[0].value == pytest.approx(truth_settling(EXCURSIONS[0]), rel=0.1)
@@ -96,7 +96,7 @@ def test_not_settled_is_a_nan_figure_that_says_why(tmp_path):
     path = tmp_path / "slow.npy"
     np.save(path, turn_on_record(5, duration=600.0, tau=1500.0))
     res = warmup(log=path, rate_hz=FS, gyro_units="rad/s", window=20.0, band=BAND)
-    for f in res.figures():
+    for f in res.figures_of_merit():
         assert math.isnan(f.value) and "not settled" in f.detail
 
 
@@ -141,7 +141,7 @@ def test_repeatability_job_on_turn_on_records_with_warm_up(tmp_path):
     assert np.all((0.5 < sig / (NOISE / np.sqrt(np.array([r["samples"] for r in res.runs]))[:, None])) & (sig < 2e-4))
     stab = np.array([r["stability"] for r in res.runs])  # 10-s means: white noise and the warm-up's last trace
     assert np.all((0.7 * NOISE / math.sqrt(10 * FS) < stab) & (stab < BAND))
-    figs = res.figures()
+    figs = res.figures_of_merit()
     assert [f.name for f in figs] == ["bias_repeatability_x", "bias_repeatability_y", "bias_repeatability_z"]
     assert all(f.unit == "rad/s" and f.sigma > 0 and "chi-square" in f.method for f in figs)
     out = tmp_path / "r.json"
@@ -159,7 +159,7 @@ def test_accelerometer_records_give_m_s2(tmp_path):
         np.savetxt(paths[-1], np.column_stack([np.arange(6000) / FS, a]), delimiter=",",
                    header="time,accel_x,accel_y,accel_z", comments="")
     res = repeatability_job(logs=paths, columns="accel_x,accel_y,accel_z", units="m/s^2", skip=0.0, period=1.0)
-    assert res.sensor == "accelerometer" and res.figures()[0].unit == "m/s^2"
+    assert res.sensor == "accelerometer" and res.figures_of_merit()[0].unit == "m/s^2"
     stab = np.array([r["stability"] for r in res.runs])  # 1-s means of white noise: 0.002 / sqrt(100)
     assert stab == pytest.approx(np.full((3, 3), 0.002 / math.sqrt(FS)), rel=0.3)
     assert np.mean(stab) == pytest.approx(0.002 / math.sqrt(FS), rel=0.1)

@@ -296,10 +296,6 @@ class PositionsResult(Result, format=FORMAT, convention=CONVENTION):
         except (KeyError, TypeError, ValueError, IndexError) as exc:
             raise InputError(f"malformed positions result ({exc}); regenerate it", where) from None
 
-    def figures(self) -> tuple[Figure, ...]:
-        """The figures of merit (:meth:`figures_of_merit`)."""
-        return self.figures_of_merit()
-
     def figures_of_merit(self) -> tuple[Figure, ...]:
         """bias, scale and cross-axis angles per sensor, and the gyro's g-sensitivity ``gsens_ij`` (rad/s per
         m/s^2); a parameter the positions do not determine has value NaN and says so."""
