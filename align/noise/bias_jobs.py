@@ -221,9 +221,9 @@ def warmup(*, log: str | Path | LogSource, progress: Progress | None = None, **f
     >>> bool(abs(res.channels[0].time - 30 * np.log(40)) < 0.1 * 30 * np.log(40)), res.figures_of_merit()[0].name
     (True, 'warmup_x')
     """
-    from align.noise.jobs import _from_sources
+    from align.noise.jobs import sources_fields
 
-    paths, given = _from_sources(log, fields_)
+    paths, given = sources_fields(log, fields_)
     _known(WarmupOptions, given, "warmup")
     return WARMUP.run(WarmupOptions(log=paths[0], **given), progress=progress)
 
@@ -303,9 +303,9 @@ def repeatability_job(*, logs: Sequence[str | Path | LogSource], progress: Progr
     -------
     RepeatabilityResult
     """
-    from align.noise.jobs import _from_sources
+    from align.noise.jobs import sources_fields
 
-    paths, given = _from_sources(logs, fields_)
+    paths, given = sources_fields(logs, fields_)
     _known(RepeatabilityOptions, given, "repeatability_job")
     return REPEATABILITY.run(RepeatabilityOptions(logs=paths, **given), progress=progress)
 

@@ -8,7 +8,7 @@ records are read and checked by :mod:`align.noise.records`.
 
 Public names
 ------------
-AllanOptions, ALLAN, allan, PlanOptions, PlanInputs, PLAN, plan (and, from records: AllanInputs,
+AllanOptions, ALLAN, allan, PlanOptions, PlanInputs, PLAN, plan, sources_fields (and, from records: AllanInputs,
 allan_unit, allan_columns, MOTION_RATE, MOTION_ACCELERATION)
 """
 
@@ -29,7 +29,7 @@ from align.noise.planner import PlanResult, make_plan, model_curve, preset_model
 from align.noise.records import MOTION_ACCELERATION, MOTION_RATE, AllanInputs, allan_columns, allan_unit, read_records
 from align.units import to_unit
 
-__all__ = ["AllanOptions", "AllanInputs", "ALLAN", "allan", "allan_unit", "allan_columns", "PlanOptions",
+__all__ = ["AllanOptions", "AllanInputs", "ALLAN", "allan", "sources_fields", "allan_unit", "allan_columns", "PlanOptions",
            "PlanInputs", "PLAN", "plan", "MOTION_RATE", "MOTION_ACCELERATION"]
 
 # ---------------------------------------------------------------------------------------------- allan
@@ -153,7 +153,7 @@ ALLAN: Job[AllanOptions, AllanInputs, AllanAnalysis] = Job(
     "Allan deviation, noise-model fit and noise figures of static recordings")
 
 
-def _from_sources(logs: Any, fields_: dict[str, Any]) -> tuple[tuple[Path, ...], dict[str, Any]]:
+def sources_fields(logs: Any, fields_: dict[str, Any]) -> tuple[tuple[Path, ...], dict[str, Any]]:
     """Paths from paths or LogSources (their columns, time, rate, unit and format, alike, become the options')."""
     items = [logs] if isinstance(logs, (str, Path, LogSource)) else list(logs)
     paths: list[Path] = []
@@ -206,7 +206,7 @@ def allan(*, logs: str | Path | LogSource | Sequence[str | Path | LogSource], pr
     >>> res.result.adev.shape[0], res.runs
     (3, 1)
     """
-    paths, given = _from_sources(logs, fields_)
+    paths, given = sources_fields(logs, fields_)
     known = {f.name for f in fields(AllanOptions)}
     unknown = sorted(set(given) - known)
     if unknown:
