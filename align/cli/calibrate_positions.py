@@ -7,7 +7,7 @@ Also ``simulate_positions``, the command ``imu-align simulate positions`` (a reh
 
 Public names
 ------------
-positions, positions_options, positions_summary, simulate_positions
+positions, positions_options, simulate_positions
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from align.cli.options import ANY, DURATION, NONNEGATIVE, POSITIVE
 from align.cli.paths import check_outputs, judged_outcome, write_run
 
 if TYPE_CHECKING:
-    from align.calibration.jobs.positions import PositionsOptions, PositionsResult
+    from align.calibration.jobs.positions import PositionsOptions
 
 
 def positions_options(*, log: Path, positions: Path, gyro_columns: str | None = None,
@@ -49,33 +49,6 @@ def positions_options(*, log: Path, positions: Path, gyro_columns: str | None = 
     return PositionsOptions(log=gyro, accel=accel, positions=positions, latitude=latitude, gravity=gravity,
                             g_sensitivity=g_sensitivity, gyro_scale=gyro_scale, window_s=window, factor=factor,
                             init_static_s=init_static, min_static_s=min_static, max_rate=max_rate, frame=frame, limits=limits)
-
-
-def positions_summary(result: PositionsResult) -> str:
-    """The terminal's table: every parameter of both sensors with its 1-sigma and observability (deg/h, deg/h per g,
-    m/s^2, ppm and deg as a test engineer reads them)."""
-    import numpy as np
-
-    from align.units import STANDARD_GRAVITY
-
-    shown = {("gyroscope", "b"): (math.degrees(1) * 3600, "deg/h"),
-             ("gyroscope", "K"): (math.degrees(1) * 3600 * STANDARD_GRAVITY, "deg/h/g"),
-             ("gyroscope", "M"): (1.0, "1"), ("accelerometer", "b"): (1.0, "m/s^2"), ("accelerometer", "M"): (1.0, "1")}
-    lines = [f"{len(result.positions)} positions at latitude {math.degrees(result.latitude):.6g} deg, gravity "
-             f"{result.gravity:.6g} m/s^2 (Earth rate removed; M rows are sensor axes)"]
-    for key in ("gyroscope", "accelerometer"):
-        fit = getattr(result, key)
-        lines.append(f"{key} (rank per axis {', '.join(str(a.rank) for a in fit.axes)}; chi-square/dof "
-                     + ", ".join(f"{c:.3g}/{d}" for c, d in zip(fit.chi2, fit.dof)) + "):")
-        for ax in fit.axes:
-            for name, v, var, st in zip(ax.names, ax.value, np.diag(ax.cov), ax.status):
-                f, unit = shown[(key, name[0])]
-                text = "not observable" if not math.isfinite(v) else \
-                    f"{v * f:.6g} +/- {math.sqrt(var) * f:.2g}" + ("" if unit == "1" else f" {unit}") + \
-                    ("" if st == "observable" else f"  ({st})")
-                lines.append(f"  {name:<5} {text}")
-        lines += [f"  note: {n}" for n in fit.notes]
-    return "\n".join(lines)
 
 
 def positions(
@@ -131,6 +104,8 @@ def positions(
 
     result, _ = POSITIONS.run_with_inputs(positions_options(**params))
     write_run(json_out, result)
+    from align.present.text import positions_summary
+
     typer.echo(positions_summary(result))
     judged_outcome(result)
 

@@ -63,15 +63,11 @@ def verify(
     params = dict(locals())
     check_outputs([result, log, plan, limits], json_out=json_out)
     from align.alignment.jobs.verify_job import VERIFY
-    from align.present.merit import shown_value
+    from align.present.merit import verify_lines
 
     res = VERIFY.run(verify_options(**params))
     write_run(json_out, res)
-    typer.echo(f"verify {result} on {log} (M estimated again on the corrected session; a working correction leaves "
-               "M = I):")
-    for f in res.verdicts:
-        value, unit = shown_value(f)
-        typer.echo(f"  {f.name:<18} {value:>28} {'' if unit == '1' else unit:<4} {f.status}")
+    typer.echo("\n".join(verify_lines(res, str(result), str(log))))
     judged_outcome(res)
 
 

@@ -97,3 +97,13 @@ def merit_parts(label: str, result, limits=None) -> tuple | None:
     rows = figures_rows(figures)
     body = table(["figure", "name", "sensor", "value", "unit", "limit", "verdict", "detail", "test"], rows, left=9)
     return verdict, Section(f"Figures of merit: {label}", head + body)
+
+
+def verify_lines(res, result: str, log: str) -> list[str]:
+    """``verify``'s terminal lines: what was replayed where, then each residual figure, its value and verdict."""
+    lines = [f"verify {result} on {log} (M estimated again on the corrected session; a working correction leaves "
+             "M = I):"]
+    for f in res.verdicts:
+        value, unit = shown_value(f)
+        lines.append(f"  {f.name:<18} {value:>28} {'' if unit == '1' else unit:<4} {f.status}")
+    return lines

@@ -6,12 +6,13 @@ are the result's file units.
 Public names
 ------------
 matrix_text, angle_lines, alignment_summary, budget_summary, allowable_summary, margin_summary,
-allan_summary, plan_summary, calibration_summary, magnetometer_summary, thermal_summary,
+allan_summary, plan_summary, calibration_summary, magnetometer_summary, thermal_summary, positions_summary,
 preset_lines (from :mod:`align.present.presets`)
 """
 
 from __future__ import annotations
 
+import math
 import re
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -377,4 +378,29 @@ def thermal_summary(result) -> str:
                          f"{v(a.rms_after):>9}  {v(a.max_after):>13}  {v(a.rms_cubic):>9}  {v(a.band_max):>8}  "
                          f"{hyst:<27} {cross}")
         lines += [f"  note: {n}" for n in s.notes]
+    return "\n".join(lines)
+
+
+def positions_summary(result) -> str:
+    """The terminal's table: every parameter of both sensors with its 1-sigma and observability (deg/h, deg/h per g,
+    m/s^2, ppm and deg as a test engineer reads them)."""
+    from align.units import STANDARD_GRAVITY
+
+    shown = {("gyroscope", "b"): (math.degrees(1) * 3600, "deg/h"),
+             ("gyroscope", "K"): (math.degrees(1) * 3600 * STANDARD_GRAVITY, "deg/h/g"),
+             ("gyroscope", "M"): (1.0, "1"), ("accelerometer", "b"): (1.0, "m/s^2"), ("accelerometer", "M"): (1.0, "1")}
+    lines = [f"{len(result.positions)} positions at latitude {math.degrees(result.latitude):.6g} deg, gravity "
+             f"{result.gravity:.6g} m/s^2 (Earth rate removed; M rows are sensor axes)"]
+    for key in ("gyroscope", "accelerometer"):
+        fit = getattr(result, key)
+        lines.append(f"{key} (rank per axis {', '.join(str(a.rank) for a in fit.axes)}; chi-square/dof "
+                     + ", ".join(f"{c:.3g}/{d}" for c, d in zip(fit.chi2, fit.dof)) + "):")
+        for ax in fit.axes:
+            for name, v, var, st in zip(ax.names, ax.value, np.diag(ax.cov), ax.status):
+                f, unit = shown[(key, name[0])]
+                text = "not observable" if not math.isfinite(v) else \
+                    f"{v * f:.6g} +/- {math.sqrt(var) * f:.2g}" + ("" if unit == "1" else f" {unit}") + \
+                    ("" if st == "observable" else f"  ({st})")
+                lines.append(f"  {name:<5} {text}")
+        lines += [f"  note: {n}" for n in fit.notes]
     return "\n".join(lines)
