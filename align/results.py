@@ -54,6 +54,7 @@ KNOWN: dict[str, str] = {
     "imu-align.budget": "mechanics.budget",
     "imu-align.drift": "align.navigation.result",
     "imu-align.thermal": "align.calibration.thermal.result",
+    "imu-align.thermal-matrix": "align.calibration.thermal.matrix_t",
     "imu-align.positions": "align.calibration.jobs.positions",
     "imu-align.warmup": "align.noise.warmup",
     "imu-align.repeatability": "align.noise.repeatability",

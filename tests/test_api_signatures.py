@@ -12,7 +12,7 @@ CALLS = {"matrix": "MatrixOptions", "apply": "ApplyOptions", "allan": "AllanOpti
          "calibrate_gyro": "GyroOptions", "budget": "BudgetOptions", "allowable": "AllowableOptions",
          "check": "CheckOptions", "drift": "DriftOptions", "calibrate_thermal": "ThermalOptions",
          "calibrate_positions": "PositionsOptions", "warmup": "WarmupOptions", "repeatability": "RepeatabilityOptions",
-         "verify": "VerifyOptions"}
+         "verify": "VerifyOptions", "calibrate_thermal_matrix": "MatrixThermalOptions"}
 
 
 @pytest.mark.parametrize("call", CALLS)

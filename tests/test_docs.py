@@ -21,6 +21,7 @@ MODULES = [
     "align.noise.periodic", "align.calibration.thermal", "align.calibration.thermal.job", "align.calibration.thermal.model",
     "align.calibration.thermal.fit", "align.calibration.thermal.branches", "align.calibration.thermal.checks",
     "align.calibration.thermal.firmware", "align.calibration.thermal.simulate", "align.calibration.thermal.result",
+    "align.calibration.thermal.matrix_t", "align.calibration.thermal.matrix_job",
     "align.job",
     "align.merit", "align.keyfigures", "align.limits", "align.judge",
     "align.calibration.jobs.positions", "align.calibration.multiposition",

@@ -34,7 +34,7 @@ story      report, demo
 exports    export
 batch      batch
 lot        lot
-calibrate  calibrate ferraris | accel | mag | gyro | thermal | positions
+calibrate  calibrate ferraris | accel | mag | gyro | thermal | positions | thermal-matrix
 inspect    inspect (what a log holds, before any job)
 """
 

@@ -116,6 +116,7 @@ FLAGS: dict[str, str] = {
     "manoeuvre": "MANOEUVRE",
     "out_dir": "OUT_DIR",
     "paths": "LOG...",
+    "results": "RESULTS",
 }
 
 #: command -> field -> flag, where a command spells a field its own way

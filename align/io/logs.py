@@ -192,12 +192,10 @@ def read_sensor_log(path: str | Path, columns: list[str], units: str | None, tim
     else:
         try:
             got = read_table(p, wanted, time_col, fmt)
-        except MissingColumns as e:
-            if not temp or e.missing != temp:
-                raise
-            raise InputError(f"no temperature column {shown(temp[0])!r} (columns: {e.listed}); name it "
-                             "with {temperature_column}, or leave it out for a log without temperature",
-                             str(path)) from None
+        except MissingColumns as e:  # the temperature column alone missing: its option, not the data columns'
+            raise e if not temp or e.missing != temp else InputError(
+                f"no temperature column {shown(temp[0])!r} (columns: {e.listed}); name it with {{temperature_column}}, "
+                "or leave it out for a log without temperature", str(path)) from None
         data = got.data
     stated = got.unit(list(columns)) if got is not None else None
     units, from_file = _units_of(units, stated, default_units, expect, field, str(path))
@@ -230,14 +228,8 @@ def read_sensor_log(path: str | Path, columns: list[str], units: str | None, tim
 def read_log(path: str | Path, columns: list[str], units: str, time_column: str | None = "time",
              rate_hz: float | None = None, expect: str | None = "angular_rate",
              log_format: LogFormat | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Read a sensor log: time (s) and data columns converted to SI (:func:`read_sensor_log`, which also
-    tells how the file was read).
-
-    Returns
-    -------
-    t : ndarray, shape (n,)
-    data : ndarray, shape (n, len(columns)), SI
-    """
+    """Read a sensor log: ``(t, data)``, time (n,) in s and the columns (n, len(columns)) in SI
+    (:func:`read_sensor_log`, which also tells how the file was read)."""
     log = read_sensor_log(path, columns, units, time_column, rate_hz, expect, log_format,
                           counts=expect == "counts")
     return log.t, log.data
