@@ -10,7 +10,7 @@ order (or time) with its control limits and spec limits; pictures are matplotlib
 Public names
 ------------
 batch_summary, lot_summary, lot_report_html, histograms_png, control_charts_png, relative_paths, capability_lines,
-signal_lines
+signal_lines, figure_label, thermal_lines
 """
 
 from __future__ import annotations
@@ -42,6 +42,19 @@ def _num(x: float, signed: bool = False, ref: float | None = None) -> str:
 
 def _unit(fs) -> str:
     return "" if fs.unit == "1" else f" {fs.unit}"
+
+
+def figure_label(fs) -> str:
+    """A figure's standard title and its key as a short code: ``cross-axis misalignment phi_xy``
+    (:data:`align.keyfigures.TITLES`)."""
+    from align.keyfigures import title
+
+    name = title(fs.figure)
+    return fs.figure if name == fs.figure else f"{name} {fs.figure}"
+
+
+def _unit_cell(fs) -> str:
+    return "ratio" if fs.unit == "1" else fs.unit
 
 
 def _per(stats) -> str:
@@ -82,7 +95,7 @@ def _cpk_cell(fs) -> str:
 
 
 def _name(fs) -> str:
-    return f"{fs.figure} ({fs.sensor}{', ' + fs.job if fs.job else ''})"
+    return f"{figure_label(fs)} ({fs.sensor}{', ' + fs.job if fs.job else ''})"
 
 
 def capability_lines(stats) -> list[str]:
@@ -120,6 +133,20 @@ def signal_lines(stats) -> list[str]:
     return out
 
 
+def thermal_lines(groupings) -> list[str]:
+    """One line per sensor grouped by thermal profile, then one per group: its units and its curve's spread."""
+    out = []
+    for g in groupings:
+        out.append(f"{g.sensor}: {g.count} group{'s' if g.count != 1 else ''} of {sum(len(x.members) for x in g.groups)} "
+                   f"units over {g.grid[0]:.1f} to {g.grid[-1]:.1f} C ({g.criterion})")
+        unit = "deg/s" if g.sensor == "gyroscope" else "m/s^2"
+        for k, grp in enumerate(g.groups, 1):
+            spread = np.degrees(grp.spread) if unit == "deg/s" else grp.spread
+            out.append(f"  group {k} ({len(grp.members)} units; shapes about its curve rms "
+                       + ", ".join(f"{v:.3g}" for v in spread) + f" {unit}): " + ", ".join(grp.members))
+    return out
+
+
 def _signal_note(stats) -> str:
     n = max((fs.n for fs in stats.figures), default=0)
     return ("(I-MR chart in lot order, limits from the lot's first units; Western Electric rules 1-4 (4: 8 in a row) and "
@@ -132,7 +159,7 @@ def _stats_rows(stats) -> list[list]:
     for fs in stats.figures:
         s, ss = _slope(fs, stats)
         ref = fs.shown(fs.std)
-        rows.append([fs.figure, fs.sensor, fs.job, fs.limit.describe() if fs.limit else "", fs.unit, fs.n,
+        rows.append([figure_label(fs), fs.sensor, fs.job, fs.limit.describe() if fs.limit else "", _unit_cell(fs), fs.n,
                      _num(fs.shown(fs.mean), True, ref), _num(ref, False, ref), _num(fs.shown(fs.minimum), True, ref),
                      _num(fs.shown(fs.maximum), True, ref), _cpk_cell(fs),
                      f"{100 * fs.yield_:.1f} %" if fs.limit else "-", len(fs.outliers),
@@ -272,8 +299,11 @@ def histograms_png(stats, start: int = 0) -> bytes:
                 label=["within", "outside"])
         _limits(ax, fs, True)
         ax.axvline(fs.shown(fs.mean), color="k", lw=0.8)
-        cpk = f", Cpk {fs.cpk:.2f}" if fs.limit is not None and math.isfinite(fs.cpk) else ""
-        ax.set_title(f"{fs.figure} ({fs.sensor}, {fs.job}){cpk}", fontsize=9)
+        cap = getattr(fs, "capability", None)
+        shown = cap.cpk if cap is not None else fs.cpk  # the Cpk the tables show (percentile: marked)
+        cpk = (f", Cpk {shown:.2f}" + (" pct" if cap is not None and cap.used == "percentile" else "")
+               if fs.limit is not None and math.isfinite(shown) else "")
+        ax.set_title(f"{figure_label(fs)}\n{fs.sensor}, {fs.job}{cpk}", fontsize=9)
         if ax is axes[0]:
             _legend(ax, fs, stats.spec is not None, ("mean", "k", "-"))
         ax.set_xlabel(fs.unit if fs.unit != "1" else "ratio", fontsize=8)
@@ -303,7 +333,7 @@ def control_charts_png(stats, start: int = 0) -> bytes:
             order = np.argsort(fs.x, kind="stable")
             at = order[[sg.index for sg in chart.signals]]
             ax.plot(fs.x[at], v[at], "x", color="tab:orange", ms=6)
-        ax.set_title(f"{fs.figure} ({fs.sensor}, {fs.job})", fontsize=9)
+        ax.set_title(f"{figure_label(fs)}\n{fs.sensor}, {fs.job}", fontsize=9)
         if ax is axes[0]:
             _legend(ax, fs, stats.spec is not None, ("mean", "k", "-"), ("control limits", "0.4", ":"))
         ax.set_xlabel("days since the first unit" if stats.trend_by == "time" else "unit (lot order)", fontsize=8)
@@ -312,7 +342,7 @@ def control_charts_png(stats, start: int = 0) -> bytes:
     return _png(plt, fig)
 
 
-def lot_report_html(stats, source: str) -> str:
+def lot_report_html(stats, source: str, thermal: tuple = ()) -> str:
     """The lot's HTML report (one self-contained page): every column visible on screen and printed (no scroll box;
     the statistics in two tables, the spread and the limits), paths in messages relative to the table's folder."""
     sections = []
@@ -361,7 +391,10 @@ def lot_report_html(stats, source: str) -> str:
         sections.append(Section("Control charts", "".join(
             image(control_charts_png(stats, k), "individuals control charts") for k in starts)
             + '<p class="note">Orange crosses: units where a run rule fired (see Control-chart signals).</p>'))
-        outl = [[s, fs.figure, fs.sensor] for fs in stats.figures for s in fs.outliers]
+        outl = [[s, figure_label(fs), fs.sensor] for fs in stats.figures for s in fs.outliers]
         if outl:
             sections.append(Section("Outliers", table(["serial", "figure", "sensor"], outl, 3)))
+    if thermal:
+        sections.append(Section("Thermal groups", "<ul>" + "".join(f"<li>{esc(c)}</li>" for c in thermal_lines(thermal))
+                                + "</ul>"))
     return html_report(f"Lot report: {source}", sections, {"table": source, "units": stats.count})

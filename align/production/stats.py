@@ -43,7 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from align.limits import Limit, Spec
-from align.production.capability import BOOTSTRAP, Capability, capability
+from align.production.capability import Capability, capability
 from align.production.control import ControlChart, control_chart
 from align.production.keyfigures import FIGURES, KIND, shown_unit, si_unit
 from align.units import to_unit
@@ -319,7 +319,7 @@ def _figure(rows: list[dict], figure: str, sensor: str, spec: Spec | None, xs: d
                        outliers, slope, slope_s, mean, lcl, ucl,
                        tuple(s for s, a in zip(serials, v) if not lcl <= a <= ucl) if math.isfinite(sigma) else (),
                        job, reading_unit,
-                       capability(v, lim.low, lim.high, resamples=min(BOOTSTRAP, max(200, 4_000_000 // len(v))))
+                       capability(v, lim.low, lim.high)
                        if lim else None, control_chart(v[order], [serials[k] for k in order]))
 
 
@@ -357,17 +357,17 @@ def lot_statistics(rows: list[dict], spec: Spec | None = None, trend_by: str = "
         One per unit and sensor (figures SI, NaN where absent), with serial, job, order, time, status, message.
     spec : Spec, optional
     trend_by : str
-        ``"order"`` (the manifest's order; slope per unit) or ``"time"`` (when each unit ran; slope per day).
+        ``"order"`` (the manifest's order; slope per unit) or ``"time"`` (when each unit was tested: its
+        ``test_time``, else when its row was made; slope per day).
 
     Returns
     -------
     LotStats
     """
-    if trend_by == "time":
-        times = [r["time"] for r in rows if r.get("time") is not None]
-        t0 = min(times) if times else None
-        xs = {id(r): (r["time"] - t0).total_seconds() / 86400.0 if r.get("time") is not None else math.nan
-              for r in rows}
+    if trend_by == "time":  # when the unit was tested (the manifest's test_time), else when its row was made
+        when = {id(r): r.get("test_time") or r.get("time") for r in rows}
+        t0 = min((t for t in when.values() if t is not None), default=None)
+        xs = {k: (t - t0).total_seconds() / 86400.0 if t is not None else math.nan for k, t in when.items()}
     else:
         xs = {id(r): float(r["order"]) if r.get("order") is not None else math.nan for r in rows}
     figures = tuple(f for f in (_figure(rows, fig, s, spec, xs, job, unit) for fig, s in _figure_names(rows, spec)

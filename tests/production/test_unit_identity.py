@@ -54,3 +54,17 @@ def test_a_zone_other_than_utc_is_kept_as_the_same_instant(tmp_path):
     got = dict(unit.identity)
     assert got["station"] == "A"
     assert datetime.fromisoformat(got["test_time"]) == datetime(2026, 1, 2, 3, 4, 5, tzinfo=timezone(timedelta(hours=-5)))
+
+
+def test_the_trend_over_time_follows_the_test_time_not_when_the_rows_were_made(tmp_path):
+    """Units tested one per 6 h over 10 days, their rows all made in one batch a minute apart: the trend per day is
+    the test time's (1e-4 per day), not the processing time's."""
+    from align.production import lot_statistics, read_spec
+
+    (tmp_path / "s.toml").write_text('scale_x = { min = 0.99, max = 1.01 }\n')
+    t0, run = datetime(2026, 1, 5, tzinfo=UTC), datetime(2026, 2, 1, tzinfo=UTC)
+    rows = [{"serial": f"U{k}", "job": "matrix", "order": 0, "time": run + timedelta(minutes=39 - k),
+             "test_time": t0 + timedelta(hours=6 * k), "status": "ok", "sensor": "gyroscope", "message": "",
+             "scale_x": 1.0 + 1e-4 * (k / 4)} for k in range(40)]
+    (fs,) = lot_statistics(rows, read_spec(tmp_path / "s.toml"), "time").figures
+    assert fs.slope == pytest.approx(1e-4) and fs.x[-1] == pytest.approx(39 / 4)
