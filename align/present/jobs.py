@@ -16,6 +16,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 
@@ -322,18 +323,26 @@ def allan_job(rep: Report, allan: Path, columns: str | None = None, rate_hz: flo
 
 
 def calibration_job(rep: Report, path: Path) -> None:
-    """A calibration result (accelerometer, Ferraris, gyro, magnetometer): its section, picture and summary number."""
+    """A calibration result (accelerometer, Ferraris, gyro, magnetometer, thermal): its section, picture and summary
+    number."""
     from align.calibration.magnetometer import MagCalibration
     from align.calibration.results import CalibrationSet
+    from align.calibration.thermal.result import ThermalCalibration
     from align.present.calsection import calibration_section, magnetometer_section
     from align.present.residuals import largest
     from align.results import load_result
     from align.vocab import Status
 
-    res = load_result(rep.source(path), (CalibrationSet, MagCalibration))
+    res = cast("CalibrationSet | MagCalibration | ThermalCalibration",  # load_result's overloads stop at two types
+               load_result(rep.source(path), (CalibrationSet, MagCalibration, ThermalCalibration)))
     name = Path(path).stem
     rep.inputs[f"calibration {name}"] = (str(path), "")
     rep.results[f"calibration {name}"] = res
+    if isinstance(res, ThermalCalibration):
+        from align.present.thermalsection import thermal_job
+
+        thermal_job(rep, Path(path), res, name)
+        return
     if isinstance(res, MagCalibration):
         from align.present.calplots import magnetometer_png
 

@@ -213,8 +213,14 @@ class ThermalModel(Value):
         t, outside = clamp(temperature, self.tmin, self.tmax)
         d = t - self.tref
         out = np.empty((len(d), 3))
+        acc = np.empty(len(d))
         for i, ax in enumerate(self.axes):
-            out[:, i] = ax.curve(d)
+            c = ax.coefficients
+            acc.fill(c[-1])  # Horner's rule in place, the operations of numpy's polyval in its order
+            for k in range(len(c) - 2, -1, -1):
+                acc *= d
+                acc += c[k]
+            out[:, i] = acc
             if rate is not None and ax.lag is not None:
                 out[:, i] += ax.lag * np.asarray(rate, float)
         return out, outside

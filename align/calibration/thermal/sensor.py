@@ -4,7 +4,7 @@ residual before and after, the held-out branch check.
 
 Public names
 ------------
-Settings, AxisReport, SensorThermal, fit_sensor
+Settings, AxisReport, SensorThermal, fit_sensor, recorded_rate
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ from align.calibration.thermal.sums import Sums, accumulate, extremes, solve, ss
 from align.errors import InputError
 from align.values import Value
 
-__all__ = ["Settings", "AxisReport", "SensorThermal", "fit_sensor"]
+__all__ = ["Settings", "AxisReport", "SensorThermal", "fit_sensor", "recorded_rate"]
 
 #: fewest samples a thermal log may hold
 MIN_SAMPLES = 200
@@ -164,6 +164,20 @@ def _rate(t: np.ndarray, temperature: np.ndarray, step: float, settings: Setting
                      f"{step:.3g} C")
         rate = temperature_rate(t, temperature, window)
     return rate
+
+
+def recorded_rate(t: np.ndarray, temperature: np.ndarray, settings: Settings) -> np.ndarray:
+    """dT/dt (n,), C/s, as :func:`fit_sensor` takes it for ``settings`` (the window widened for a stepped reading):
+    what a report needs to find the branches and the lag term again.
+
+    Examples
+    --------
+    >>> t = np.arange(2000.0)
+    >>> float(recorded_rate(t, 20 + 0.01 * t, Settings())[1000].round(6))
+    0.01
+    """
+    t, temperature = np.asarray(t, float), np.asarray(temperature, float)
+    return _rate(t, temperature, checks.resolution(temperature), settings, [])
 
 
 def _axis(s: Sums, axis: int, cands: list[tuple[int, bool]], do_branches: bool, folds: int):

@@ -25,6 +25,10 @@ __all__ = ["Sums", "accumulate", "extremes", "solve", "sse", "CHUNK"]
 
 #: rows per chunk of the one pass (the design of a chunk is CHUNK x (P + 5) floats)
 CHUNK = 1 << 16
+#: rows per chunk of the pass of :func:`extremes`: its product (3 x (P + 2) by (P + 2) x SMALL_CHUNK) stays below
+#: the size at which OpenBLAS spreads a product over threads (m n k < 262144), which on a loaded machine made it
+#: ten times slower; the chunk (80 kB a row) also stays in the cache
+SMALL_CHUNK = 1 << 13
 
 
 @dataclass(frozen=True, eq=False)
@@ -163,14 +167,20 @@ def extremes(temperature: np.ndarray, rate: np.ndarray, readings: np.ndarray, s:
     for the readings less their mean.
     """
     n, P = len(temperature), s.P
-    z = np.empty((P + 5, min(CHUNK, n)))
-    before, after = np.zeros(3), np.zeros(3)
-    for a in range(0, n, CHUNK):
-        zz = _design(temperature, rate, readings, a, min(a + CHUNK, n), P, s.tc, s.hs, s.rs, s.ymean, z)
-        y = zz[P + 2:]
-        before = np.maximum(before, np.abs(y).max(axis=1))
-        after = np.maximum(after, np.abs(y - W.T @ zz[:P + 2]).max(axis=1))
-    return before, after
+    z = np.empty((P + 5, min(SMALL_CHUNK, n)))
+    model = np.empty((3, min(SMALL_CHUNK, n)))
+    extreme = np.zeros((4, 3))  # largest and smallest y, largest and smallest y - model
+    Wt = W.T
+    for a in range(0, n, SMALL_CHUNK):
+        zz = _design(temperature, rate, readings, a, min(a + SMALL_CHUNK, n), P, s.tc, s.hs, s.rs, s.ymean, z)
+        y, m = zz[P + 2:], model[:, :zz.shape[1]]
+        np.matmul(Wt, zz[:P + 2], out=m)
+        np.subtract(y, m, out=m)
+        np.maximum(extreme[0], y.max(axis=1), out=extreme[0])
+        np.minimum(extreme[1], y.min(axis=1), out=extreme[1])
+        np.maximum(extreme[2], m.max(axis=1), out=extreme[2])
+        np.minimum(extreme[3], m.min(axis=1), out=extreme[3])
+    return np.maximum(extreme[0], -extreme[1]), np.maximum(extreme[2], -extreme[3])
 
 
 def solve(G: np.ndarray, cols: list[int], y: int) -> np.ndarray:
