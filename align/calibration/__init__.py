@@ -28,30 +28,67 @@ alignment_to_gravity, misalignment_from_axes_down, MODELS, GyroSession, Rotation
 in_system_frame, session_intervals
 """
 
-from align.calibration.accel import (
-                                     FACES,
-                                     StaticDetector,
-                                     accel_session,
-                                     calibrate_accel,
-                                     calibrate_accel_free,
-                                     calibrate_accel_log,
-                                     face_ups,
-                                     session_intervals,
-                                     static_means,
-)
-from align.calibration.ellipsoid import MODELS
-from align.calibration.ferraris import SECTIONS, ferraris, sections_from_dict
-from align.calibration.gyro import GyroSession, RotationReport, calibrate_gyro_session
-from align.calibration.gyroframe import in_system_frame
-from align.calibration.magnetometer import (
-                                     MagCalibration,
-                                     alignment_to_gravity,
-                                     calibrate_magnetometer,
-                                     misalignment_from_axes_down,
-                                     with_gravity_alignment,
-)
-from align.calibration.positions import Position, parse_positions, positions_of
-from align.calibration.results import SENSORS, Calibration, CalibrationSet
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # the names for type checkers; at run time each is imported when first asked for
+    from align.calibration.accel import (
+                                         FACES,
+                                         StaticDetector,
+                                         accel_session,
+                                         calibrate_accel,
+                                         calibrate_accel_free,
+                                         calibrate_accel_log,
+                                         face_ups,
+                                         session_intervals,
+                                         static_means,
+    )
+    from align.calibration.ellipsoid import MODELS
+    from align.calibration.ferraris import SECTIONS, ferraris, sections_from_dict
+    from align.calibration.gyro import GyroSession, RotationReport, calibrate_gyro_session
+    from align.calibration.gyroframe import in_system_frame
+    from align.calibration.magnetometer import (
+                                         MagCalibration,
+                                         alignment_to_gravity,
+                                         calibrate_magnetometer,
+                                         misalignment_from_axes_down,
+                                         with_gravity_alignment,
+    )
+    from align.calibration.positions import Position, parse_positions, positions_of
+    from align.calibration.results import SENSORS, Calibration, CalibrationSet
+
+#: name -> the module that defines it (imported on first use: `import align.calibration.thermal` stays light)
+_WHERE = {
+    "FACES": "accel",
+    "StaticDetector": "accel",
+    "accel_session": "accel",
+    "calibrate_accel": "accel",
+    "calibrate_accel_free": "accel",
+    "calibrate_accel_log": "accel",
+    "face_ups": "accel",
+    "session_intervals": "accel",
+    "static_means": "accel",
+    "MODELS": "ellipsoid",
+    "SECTIONS": "ferraris",
+    "ferraris": "ferraris",
+    "sections_from_dict": "ferraris",
+    "GyroSession": "gyro",
+    "RotationReport": "gyro",
+    "calibrate_gyro_session": "gyro",
+    "in_system_frame": "gyroframe",
+    "MagCalibration": "magnetometer",
+    "alignment_to_gravity": "magnetometer",
+    "calibrate_magnetometer": "magnetometer",
+    "misalignment_from_axes_down": "magnetometer",
+    "with_gravity_alignment": "magnetometer",
+    "Position": "positions",
+    "parse_positions": "positions",
+    "positions_of": "positions",
+    "SENSORS": "results",
+    "Calibration": "results",
+    "CalibrationSet": "results",
+}
+
 
 __all__ = ["Calibration", "CalibrationSet", "SENSORS", "FACES", "face_ups", "static_means", "accel_session",
            "calibrate_accel_log", "StaticDetector", "Position", "parse_positions", "positions_of",
@@ -59,3 +96,15 @@ __all__ = ["Calibration", "CalibrationSet", "SENSORS", "FACES", "face_ups", "sta
            "calibrate_magnetometer", "with_gravity_alignment", "alignment_to_gravity",
            "misalignment_from_axes_down", "MODELS", "GyroSession", "RotationReport", "calibrate_gyro_session",
            "in_system_frame", "session_intervals"]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _WHERE:
+        value = getattr(importlib.import_module(f"align.calibration.{_WHERE[name]}"), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'align.calibration' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)
