@@ -55,6 +55,8 @@ KIND: dict[str, str] = {
     **{f"residual_scale_{a}": "1" for a in AXES},
     **{f"residual_phi_{p}": "angle" for p in _CROSS},
     "residual_norm_rms": "reading", "residual_norm_max": "reading", "residual_rate_rms": "reading",
+    **{f"hysteresis_{a}": "reading" for a in AXES},
+    **{f"thermal_residual_{a}": "reading" for a in AXES},
 }
 #: every figure, in the table's column order
 FIGURES: tuple[str, ...] = tuple(KIND)
@@ -80,7 +82,9 @@ _TITLE_OF = {"M": "matrix element", "scale": "scale factor", "phi": "cross-axis 
              "bias repeatability (turn-on to turn-on)", "gsens": "g-sensitivity of the bias",
              "residual_scale": "residual scale error after correction", "residual_phi":
              "residual misalignment after correction", "residual_norm": "residual of |reading| after correction",
-             "residual_rate": "residual rate error after correction"}
+             "residual_rate": "residual rate error after correction",
+             "hysteresis": "thermal hysteresis of the bias (heating minus cooling)",
+             "thermal_residual": "bias residual after thermal compensation (rms)"}
 #: figure -> its standard name
 TITLES: dict[str, str] = {}
 for _f in KIND:

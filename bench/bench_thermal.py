@@ -3,10 +3,12 @@
 The record: a static gyro in a chamber, -10 to 60 C up, down and up (the `simulate thermal` profile), at the
 rate that makes ``--rows`` samples; columns ``time, gyro_x, gyro_y, gyro_z (deg/s), temperature (C)``
 (``--sensors 2``: the accelerometer's three columns beside them, both sensors calibrated: 6 channels).
-Written in a temporary folder (removed afterwards) as CSV, and as .npy for the fit alone.
+Written in a temporary folder (removed afterwards) as CSV, as Parquet (the same columns, float64), and as .npy
+for the fit alone.
 
 Each measured as a whole process (start-up included):
-  1. `imu-align calibrate thermal LOG --temperature-column temperature --json OUT`: the command;
+  1. `imu-align calibrate thermal LOG --temperature-column temperature --json OUT`: the command, on the CSV and
+     on the Parquet file;
   2. the job's reading alone (`THERMAL.read`, the checked CSV reader of align.io);
   3. the fit alone: `fit_sensor` on the arrays loaded from .npy (what this module owns).
 Prints wall time, CPU time, peak RSS, the input size (CSV bytes; the arrays' bytes in memory) and the ratio of
@@ -76,6 +78,10 @@ def make_log(folder: Path, rows: int, sensors: int) -> tuple[Path, Path, float]:
     names = ["time", "gyro_x", "gyro_y", "gyro_z"] + (["acc_x", "acc_y", "acc_z"] if sensors > 1 else []) + ["temperature"]
     log = folder / "thermal.csv"
     write_csv(log, names, table)
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    pq.write_table(pa.table({n: table[:, k] for k, n in enumerate(names)}), folder / "thermal.parquet")
     np.save(folder / "t.npy", table[:, 0])
     np.save(folder / "temperature.npy", table[:, -1])
     np.save(folder / "gyroscope.npy", table[:, 1:4] * (np.pi / 180))  # SI, as the reader gives them
@@ -102,6 +108,9 @@ def run(args: argparse.Namespace, folder: Path) -> None:
         "calibrate thermal (command)": [sys.executable, "-m", "align.cli", "calibrate", "thermal", str(log),
                                         "--temperature-column", "temperature", "--sensors", ",".join(sensors),
                                         "--json", str(folder / "r.json")],
+        "calibrate thermal (Parquet log)": [sys.executable, "-m", "align.cli", "calibrate", "thermal",
+                                            str(folder / "thermal.parquet"), "--temperature-column", "temperature",
+                                            "--sensors", ",".join(sensors), "--json", str(folder / "rp.json")],
         "reading alone (THERMAL.read)": [sys.executable, "-c", READ, str(log), str(args.sensors)],
         "fit alone (fit_sensor on .npy)": [sys.executable, "-c", FIT, str(arrays), repr(rate_hz), str(args.sensors)],
     }

@@ -206,19 +206,7 @@ def _axis_rows(st, factor: float) -> list[list[str]]:
     return rows
 
 
-def _figures(figures) -> str:
-    """The figures of merit of this sensor with their verdicts (:func:`align.present.merit.figures_rows`)."""
-    from align.present.merit import figures_rows
-
-    if not figures:
-        return '<p class="note">The result gives no figures of merit.</p>'
-    return ("<p>Figures of merit, each with its limit and verdict:</p>"
-            + table(["figure", "name", "sensor", "value", "unit", "limit", "verdict", "detail", "test"],
-                    figures_rows(figures), left=9))
-
-
-def thermal_section(res, sensor: str, source: str, picture: bytes | None = None, note: str = "",
-                    figures=()) -> Section:
+def thermal_section(res, sensor: str, source: str, picture: bytes | None = None, note: str = "") -> Section:
     """One sensor's thermal calibration (module docstring).
 
     Parameters
@@ -232,8 +220,6 @@ def thermal_section(res, sensor: str, source: str, picture: bytes | None = None,
         :func:`thermal_png` of the sensor.
     note : str
         One sentence: why the readings are not drawn (empty when they are).
-    figures : sequence of Figure
-        The result's figures of merit of this sensor, judged.
 
     Returns
     -------
@@ -255,7 +241,6 @@ def thermal_section(res, sensor: str, source: str, picture: bytes | None = None,
     body += (f"<p>The fit of each axis; residuals in {esc(unit)}: before, with a constant bias removed; after, "
              "with the model and its lag term; hysteresis: heating minus cooling at equal temperature where "
              "largest:</p>" + table(head, _axis_rows(st, factor)))
-    body += _figures(figures)
     if picture:
         if note:
             body += f'<p class="note">{esc(note)}</p>'
@@ -288,18 +273,15 @@ def thermal_job(rep, path: Path, res, name: str) -> None:
     import dataclasses
 
     from align.calibration.thermal.sensor import Settings
-    from align.job import judged
     from align.present.figures import display_unit
     from align.present.verdicts import INFO, Verdict
 
     recorded = res.inputs.get("settings") or {}
     settings = Settings(**{f.name: recorded[f.name] for f in dataclasses.fields(Settings) if f.name in recorded})
-    figures = res.verdicts or judged(res, f"calibration {name}")
     for sensor, st in res.sensors.items():
         record, why = read_thermal_log(path, res.inputs, sensor, st.units)
         png = thermal_png(st, settings, record)
-        rep.add("calibration", thermal_section(res, sensor, str(path), png, why,
-                                               [f for f in figures if f.sensor == sensor]))
+        rep.add("calibration", thermal_section(res, sensor, str(path), png, why))  # its figures: story's section
         factor, unit = display_unit(st.units, (_DIMENSION.get(sensor, "acceleration"),))
         k = int(np.argmax([a.max_after for a in st.axes]))
         ax = st.axes[k]

@@ -132,6 +132,23 @@ class ThermalCalibration(Result, format=FORMAT, convention=CONVENTION):
         return ThermalCorrection(model, self.sensors[model.sensor].units,
                                  float(self.inputs.get("settings", {}).get("window_s", 20.0)))
 
+    def figures_of_merit(self) -> tuple:
+        """Per sensor and axis: ``hysteresis_i`` (heating minus cooling where largest, with its 1-sigma; not given
+        when the branches were not compared) and ``thermal_residual_i`` (rms of the residual after compensation)."""
+        from align.keyfigures import figures_from
+
+        out: tuple = ()
+        for key, s in self.sensors.items():
+            values: dict[str, float] = {}
+            for a, rep in zip("xyz", s.axes):
+                if rep.hysteresis is not None:
+                    values[f"hysteresis_{a}"] = rep.hysteresis.value
+                    values[f"hysteresis_{a}_sigma"] = rep.hysteresis.sigma
+                values[f"thermal_residual_{a}"] = rep.rms_after
+            out += figures_from(values, key, method="bias against temperature: polynomial (order by blocked "
+                                "cross-validation) and lag, heating and cooling compared at equal temperature")
+        return out
+
     def to_dict(self) -> dict[str, Any]:
         """The versioned JSON form: the envelope, ``inputs``, ``band``, then one key per sensor."""
         out = {**self.envelope({**{k: s.units for k, s in self.sensors.items()}, "temperature": "degC"}),
