@@ -14,10 +14,10 @@ assumption): non-negative ``p`` minimising ``(y - A p)' S(p)^-1 (y - A p)`` over
 times, then only the terms the data demand (:mod:`align.noise.gls`: a likelihood-ratio test of each term
 against the model refitted without it, chi-bar-square p-values, Holm's step-down procedure over the
 :data:`~align.noise.gls.TRIED` terms tried at the family-wise rate :data:`~align.noise.gls.FALSE_ALARM`; a
-ramp that fails leaves the model, a noise term that fails stays in it unclaimed). The ramp's cross term with
-the rate random walk is in the covariance (:mod:`align.noise.covariance`). The covariance of ``p`` is
-``(A' S^-1 A)^-1`` on the kept terms, scaled by ``chi2 / dof`` when above 1 (a curve the model does
-not describe), and a parameter's 1-sigma is ``sigma(p_k) / (2 sqrt(p_k))``.
+ramp that fails leaves the model, a noise term that fails stays in it unclaimed). The ramp's cross terms with
+every noise term (white, flicker, random walk, quantization) are in the covariance (:mod:`align.noise.covariance`).
+The covariance of ``p`` is ``(A' S^-1 A)^-1`` on the kept terms, scaled by ``chi2 / dof`` when above 1 (a curve
+the model does not describe), and a parameter's 1-sigma is ``sigma(p_k) / (2 sqrt(p_k))``.
 
 A term is identifiable when Holm's test claims it, it is at least 30 % of the model at some fitted tau,
 and it is known to 25 % (1-sigma). Otherwise the fit gives its one-sided 95 % upper bound (the largest value
