@@ -1,14 +1,16 @@
 """One stream of a log of several streams (a ULog, a ROS bag) as a chunk source, read in bounded memory.
 
 The reader's ``chunks`` (:attr:`align.io.readers.LogReader.chunks`: ``chunks(path, log_format, names, rows)``
-yielding :class:`~align.io.readers.Columns` blocks) is run once: the time column of each block counts the
-samples, gives the sample rate (the median step of the first :data:`HEAD` steps) and is checked: a time that
-does not increase or a gap (a step beyond 1.5 times the median, or below half of it: the uniform samples an
-Allan deviation needs) is refused with its position, as :func:`align.io.checks.check_time` does for a log read
-whole; the data columns are written, as read (float64), to a temporary raw file, removed once the source is
-released (at exit at the latest). That file is then read as :class:`align.io.logs.NpyChunks` reads raw binary:
-in chunks, and mapped for the sampled checks of a record (a second decoding of the log would double the time;
-the file costs a write and a read of ``8 n C`` bytes, from the page cache).
+yielding :class:`~align.io.readers.Columns` blocks) is run once: the time column of each block counts the samples,
+gives the sample rate (the median step of the first :data:`HEAD` steps) and is checked: a time that does not
+increase or a gap (a step beyond 1.5 times the median, or below half of it: the uniform samples an Allan deviation
+needs) is refused with its position, as :func:`align.io.checks.check_time` does for a log read whole; the data
+columns are checked (NaN, inf, absurd readings refused by sample, as allan does: ``checked``) and written, as read
+(float64), to a temporary raw file, removed once the source is released (at exit at the latest). That file is then
+read in chunks, as :class:`align.io.logs.NpyChunks` reads raw binary but through a mapping let go behind each chunk
+(fast enough for one pass per group of channels, see :func:`align.noise.allan.allan`), and mapped for the sampled
+checks of a record (a second decoding of the log would double the time; the file costs a write of ``8 n C`` bytes
+and reads from the page cache).
 
 Public names
 ------------
@@ -17,6 +19,7 @@ StreamChunks, stream_source, HEAD, CHUNKED_BYTES, ROWS
 
 from __future__ import annotations
 
+import mmap
 import os
 import tempfile
 import weakref
@@ -27,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from align.errors import InputError
+from align.io.checks import check_readings
 from align.io.formats import TIME_UNITS, LogFormat
 from align.io.logs import NpyChunks
 
@@ -74,6 +78,8 @@ class StreamChunks(NpyChunks):
         The units the reader states (``{"gyro_x": "rad/s", "time": "s"}``).
     source, notes
         The stream read and the reader's remarks (those of the last block).
+    checked : bool
+        True: every reading was checked as written (:func:`align.noise.allan.allan` need not check them again).
 
     Examples
     --------
@@ -97,8 +103,30 @@ class StreamChunks(NpyChunks):
         fd, spill = tempfile.mkstemp(prefix="imu_align_stream_", suffix=".f8")
         weakref.finalize(self, _remove, spill)  # when released, or at exit
         with os.fdopen(fd, "wb") as fh:
-            self.rate_hz = self._read(chunks(self.log, log_format, [time_column, *self.names], rows), fh)
+            self.rate_hz = self._read(chunks(self.log, log_format, [time_column, *self.names], rows), fh, scale)
         super().__init__(spill, len(self.names), scale)
+        self.checked = True  # every reading checked as written: allan need not read all columns again to check
+
+    def chunks(self, rows: int = 1 << 20, columns: list[int] | None = None) -> Iterator[np.ndarray]:
+        """Yield float64 arrays of up to ``rows`` rows (all columns, or the ones listed), as
+        :meth:`NpyChunks.chunks <align.io.logs.NpyChunks.chunks>` does, but gathered from a read-only mapping of
+        the temporary file whose pages are let go behind each block (Linux: bounded memory). Gathering a column
+        costs one pass over the mapped rows, about a fifth of reading them into a buffer first: allan reads a
+        long record once per group of channels."""
+        n, c = self.shape
+        with open(self.path, "rb") as fh, mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as mm:
+            arr = np.frombuffer(mm, self.dtype, n * c).reshape(n, c)
+            try:
+                for start in range(0, n, rows):
+                    stop = min(n, start + rows)
+                    block = np.asarray(arr[start:stop].copy() if columns is None else arr[start:stop, columns],
+                                       dtype=np.float64)  # a copy: no view of the mapping
+                    lo, hi = (r * c * self.dtype.itemsize // mmap.PAGESIZE * mmap.PAGESIZE for r in (start, stop))
+                    if hasattr(mmap, "MADV_DONTNEED") and hi > lo:  # the pages read go (kept in the page cache)
+                        mm.madvise(mmap.MADV_DONTNEED, lo, hi - lo)
+                    yield block * self.scale if self.scale != 1 else block
+            finally:
+                del arr  # no view may outlive the mapping
 
     @property
     def time_units(self) -> str:
@@ -110,12 +138,13 @@ class StreamChunks(NpyChunks):
         units = {self.units.get(n) for n in self.names}
         return units.pop() if len(units) == 1 else None
 
-    def _read(self, blocks: Iterator[Any], fh) -> float:
-        """Write each block's data columns to ``fh``; count the samples, take the rate from the head's median step,
-        refuse steps back and gaps. Returns the rate, Hz."""
+    def _read(self, blocks: Iterator[Any], fh, scale: float) -> float:
+        """Write each block's data columns to ``fh``, refusing readings that are none (times ``scale``: NaN, inf,
+        absurd; :func:`align.io.checks.check_readings`, named by sample as allan names them); count the samples, take
+        the rate from the head's median step, refuse steps back and gaps. Returns the rate, Hz."""
         where = str(self.log)
         head: list[np.ndarray] = []
-        n, factor, med, prev = 0, 1.0, None, None
+        n, factor, med, prev, written = 0, 1.0, None, None, 0
         gaps, first = 0, None  # gaps beyond the median's tolerance; the first (t, step)
         for got in blocks:
             if not self.units:
@@ -124,7 +153,13 @@ class StreamChunks(NpyChunks):
             self.source, self.notes = dict(got.source), tuple(got.notes)
             if not len(got.data):
                 continue
-            np.ascontiguousarray(got.data[:, 1:], dtype=np.float64).tofile(fh)
+            data = np.ascontiguousarray(got.data[:, 1:], dtype=np.float64)
+            try:
+                check_readings(data * scale if scale != 1 else data, where, first_row=written)  # samples from 0
+            except InputError as exc:
+                raise InputError(exc.message.replace("data row", "sample"), exc.where) from None
+            data.tofile(fh)
+            written += len(data)
             t = np.asarray(got.data[:, 0], dtype=np.float64) * factor
             if med is None:
                 head.append(t)

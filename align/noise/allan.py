@@ -6,11 +6,12 @@ For rate samples ``y`` at ``fs`` the phase is ``x = [0, cumsum(y - mean(y)) / fs
     AVAR(m tau0)  = sum_i (x[i+2m] - 2 x[i+m] + x[i])^2 / (2 (m tau0)^2 (N - 2m))
     MVAR(m tau0)  = sum_j (sum_{i=j}^{j+m-1} (x[i+2m] - 2 x[i+m] + x[i]))^2 / (2 m^2 (m tau0)^2 (N - 3m + 1))
 
-(N phase points; IEEE Std 1139 / Riley, NIST SP 1065). The sums run in a
-compiled kernel (numba; tiled over blocks of the record, parallel, vectorised),
-with no temporaries the size of the record; the phase is built in place, and a record
-larger than ``memory_limit`` bytes keeps its phase in a temporary file
-(``numpy.memmap``), so 1e8-sample recordings run in bounded memory.
+(N phase points; IEEE Std 1139 / Riley, NIST SP 1065). The sums run in a compiled kernel (numba; tiled over
+blocks of the record, parallel, vectorised), with no temporaries the size of the record. The phase is built in
+place for a group of channels at a time, as many as :data:`GROUP_BYTES` hold (the record read once per group):
+each channel's sums are its own, so the results do not depend on the grouping, and the memory used stays that of
+one group (one channel of a record longer than a day at 400 Hz); one channel's phase beyond ``memory_limit`` bytes
+lives in a temporary file (``numpy.memmap``).
 
 Every point carries the noise type identified from the data at its tau (lag-1
 autocorrelation, B1 ratio; :mod:`align.noise.identify`, NIST SP 1065 section 5.6),
@@ -27,7 +28,6 @@ NOISE_ALPHA (from :mod:`align.noise.model`)
 
 from __future__ import annotations
 
-import os
 import tempfile
 from dataclasses import dataclass
 
@@ -88,13 +88,6 @@ def tau_grid(n: int, fs: float, grid: str | list = "dense", per_decade: int = 10
     return m
 
 
-def _get_kernels():
-    """The compiled ``avar_sums`` and ``mvar_sums`` (numba is imported only when needed)."""
-    from align.noise._kernels import avar_sums, mvar_sums
-
-    return avar_sums, mvar_sums
-
-
 class ArrayChunks:
     """Row chunks of an in-memory (n, C) array, with the interface of :class:`align.io.NpyChunks`."""
 
@@ -109,50 +102,61 @@ class ArrayChunks:
             yield np.asarray(self.data[start : start + rows, cols], dtype=np.float64)
 
 
-def _phases(source, fs: float, memory_limit: float, names, progress=None,
-            where: str | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Phases ``[0, cumsum(y - c) / fs]`` of every column in one pass, shape (C, n + 1).
+#: bytes of phase held in memory at once, however large ``memory_limit``: the channels are taken in groups that fit,
+#: the source read once per group (one 24-hour 400 Hz channel's phase is 277 MB); fewer cost more reads of the source
+GROUP_BYTES = 320e6
 
-    ``c`` is the mean of the first chunk (the whole column when it fits one
-    chunk, as allantools does): removing a constant near the mean keeps the
-    running sum small and precise, and any constant cancels exactly in the
-    second differences. The running sums carry across chunks, so each row
-    equals one ``numpy.cumsum`` over its column. Phases larger than
-    ``memory_limit`` bytes live in a temporary file (``numpy.memmap``) that is
-    gone once released. Returns the phases, the constants and the column means.
+
+def _groups(n: int, c: int, memory_limit: float) -> list[list[int]]:
+    """The channels of each pass: as many as fit ``min(memory_limit, GROUP_BYTES)`` bytes of phase, at least one."""
+    g = max(1, min(c, int(min(memory_limit, GROUP_BYTES) // (8 * (n + 1)))))
+    return [list(range(s, min(s + g, c))) for s in range(0, c, g)]
+
+
+def _phases(source, fs: float, memory_limit: float, columns: list[int], check: bool = True, progress=None,
+            where: str | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Phases ``[0, cumsum(y - c) / fs]`` of the ``columns`` of ``source`` in one pass, shape (len(columns), n + 1).
+
+    ``c`` is the mean of the first chunk (the whole column when it fits one chunk, as allantools does): removing
+    a constant near the mean keeps the running sum small and precise, and any constant cancels exactly in the
+    second differences. The running sums carry across chunks, so each row equals one ``numpy.cumsum`` over its
+    column, whatever columns are read beside it. Phases larger than ``memory_limit`` bytes live in a temporary
+    file (``numpy.memmap``) that is gone once released. With ``check``, every column of each chunk is checked
+    (:func:`align.io.logs.check_readings`), not only those used. Returns the phases and the columns' means.
     """
-    n, c = source.shape
+    n, c_all = source.shape
+    c = len(columns)
     x: np.ndarray
     if c * (n + 1) * 8 > memory_limit:
-        fd, path = tempfile.mkstemp(prefix="imu_align_phase_", suffix=".f8")
-        os.close(fd)
-        x = np.memmap(path, dtype=np.float64, mode="w+", shape=(c, n + 1))
-        os.unlink(path)  # the mapping keeps the file alive; nothing is left behind
+        with tempfile.TemporaryFile(prefix="imu_align_phase_", suffix=".f8") as fh:  # unlinked at once
+            x = np.memmap(fh, dtype=np.float64, mode="w+", shape=(c, n + 1))  # the mapping keeps it alive
     else:
         x = np.empty((c, n + 1))
     x[:, 0] = 0.0
-    pos, carry, total, const = 1, np.zeros(c), np.zeros(c), None
-    for chunk in source.chunks():
+    pos, carry, total, const = 1, np.zeros(c), np.zeros(c), np.zeros(c)
+    sub = not check and c != c_all  # the chunks hold only ``columns``
+    cols = list(range(c)) if sub else list(columns)
+    for chunk in source.chunks(columns=columns if sub else None):
         k = len(chunk)
-        try:
-            check_readings(chunk, where or "record", first_row=pos - 1)  # samples count from 0
-        except InputError as exc:  # named by sample: a chunk source has no header row
-            raise InputError(exc.message.replace("data row", "sample"), exc.where) from None
-        if const is None:
-            const = np.array([np.mean(chunk[:, j]) for j in range(c)])
-        for j in range(c):
-            seg = x[j, pos : pos + k]
-            np.subtract(chunk[:, j], const[j], out=seg)
-            total[j] += np.sum(seg)
-            seg[0] += carry[j]
+        if check:
+            try:
+                check_readings(chunk, where or "record", first_row=pos - 1)  # samples count from 0
+            except InputError as exc:  # named by sample: a chunk source has no header row
+                raise InputError(exc.message.replace("data row", "sample"), exc.where) from None
+        if pos == 1:
+            const = np.array([np.mean(chunk[:, j]) for j in cols])
+        for i, j in enumerate(cols):
+            seg = x[i, pos : pos + k]
+            np.subtract(chunk[:, j], const[i], out=seg)
+            total[i] += np.sum(seg)
+            seg[0] += carry[i]
             np.cumsum(seg, out=seg)
-            carry[j] = seg[-1]
+            carry[i] = seg[-1]
         pos += k
         if progress is not None:
             progress(pos - 1)
     x[:, 1:] *= 1.0 / fs
-    assert const is not None, "a record holds at least one chunk"
-    return x, const, const + total / n
+    return x, const + total / n
 
 
 def window_stability(x: np.ndarray, fs: float, period: float) -> float:
@@ -314,7 +318,7 @@ def allan(data, fs: float, names=None, grid="dense", per_decade: int = 10, modif
     data : array_like, shape (n,) or (n, C), or a chunk source
         Rate samples, uniform in time; an in-memory array or an object with
         ``shape`` and ``chunks(rows, columns)`` such as :class:`align.io.NpyChunks`
-        (read twice per channel, never whole).
+        (read in chunks, once per group of channels, never whole; ``checked`` True: its readings were checked).
     fs : float
         Sample rate, Hz.
     names : sequence of str, optional
@@ -323,7 +327,8 @@ def allan(data, fs: float, names=None, grid="dense", per_decade: int = 10, modif
     modified : bool
         Also compute the modified Allan deviation.
     memory_limit : float
-        Bytes of phase kept in memory; a larger phase goes to a temporary file.
+        Bytes of phase kept in memory (at most :data:`GROUP_BYTES` are: the channels are taken in groups, the
+        source read once per group); one channel's phase beyond it goes to a temporary file.
     progress : callable, optional
         Called with the number of samples read so far.
     periods : sequence of float
@@ -362,38 +367,44 @@ def allan(data, fs: float, names=None, grid="dense", per_decade: int = 10, modif
     n, c = source.shape
     names = tuple(names) if names is not None else tuple(f"col{j}" for j in range(c))
     m = tau_grid(n, fs, grid, per_decade)
-    avar_sums, mvar_sums = _get_kernels()
     tau = m / fs
-    x, _, means = _phases(source, fs, memory_limit, names, progress, where)
-    adev = np.sqrt(avar_sums(x, m) / (2.0 * tau**2 * (n + 1 - 2 * m))) if deviations else np.full((c, len(m)), np.nan)
-    mdev = None
-    if modified and deviations:
-        mdev = np.full((c, len(m)), np.nan)
-        mm = m[3 * m <= n + 1]
-        mdev[:, : len(mm)] = np.sqrt(mvar_sums(x, mm) / (2.0 * mm.astype(float) ** 2 * (mm / fs) ** 2 * (n + 1 - 3 * mm + 1)))
-    alpha = edf = edf_m = None
-    if deviations:
-        alpha, edf, edf_m = _identified(x, m, adev, mdev, fs, mvar_sums)
-    stability = {p: np.array([window_stability(x[j], fs, p) for j in range(c)]) for p in periods}
-    del x
+    adev, means, stability = np.full((c, len(m)), np.nan), np.empty(c), {p: np.empty(c) for p in periods}
+    mdev = np.full((c, len(m)), np.nan) if modified and deviations else None
+    alpha, edf, edf_m = (np.zeros((c, len(m)), np.int64), np.empty((c, len(m))), None if mdev is None else
+                         np.empty((c, len(m)))) if deviations else (None, None, None)
+    groups = _groups(n, c, memory_limit)
+    for g, cols in enumerate(groups):  # the source read once per group: one group's phases in memory at a time
+        step = None if progress is None else (lambda k, g=g: progress((g * n + k) // len(groups)))
+        x, means[cols] = _phases(source, fs, memory_limit, cols, g == 0 and not getattr(source, "checked", False),
+                                 step, where)
+        if deviations:
+            _deviations(x, m, fs, cols, adev, mdev, alpha, edf, edf_m)
+        for p in periods:
+            stability[p][cols] = [window_stability(x[i], fs, p) for i in range(len(cols))]
+        del x
     return AllanResult(tau, m, adev, mdev, n, fs, names, means, stability, alpha, edf, edf_m)
 
 
-def _identified(x, m, adev, mdev, fs, mvar_sums) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
-    """Noise type of every point and the Greenhall EDF of ``adev`` (and ``mdev``) that follows."""
+def _deviations(x, m, fs, cols, adev, mdev, alpha, edf, edf_m) -> None:
+    """The deviations of the channels ``cols`` from their phases ``x``, the noise type of every point and the
+    Greenhall EDF that follows, written into those arrays' rows ``cols``."""
+    from align.noise._kernels import avar_sums, mvar_sums  # numba is imported only when needed
     from align.noise.identify import edf_of, identify_noise
 
     n_phase = x.shape[1]
+    adev[cols] = np.sqrt(avar_sums(x, m) / (2.0 * (m / fs) ** 2 * (n_phase - 2 * m)))
+    if mdev is not None:
+        mm = m[3 * m <= n_phase]
+        mdev[cols, : len(mm)] = np.sqrt(mvar_sums(x, mm) / (2.0 * mm.astype(float) ** 2 * (mm / fs) ** 2
+                                                             * (n_phase - 3 * mm + 1)))
 
     def mvar_of(k: int) -> np.ndarray:  # only where the B1 ratio finds phase noise
-        if mdev is not None and np.all(np.isfinite(mdev[:, k])):
-            return mdev[:, k] ** 2
+        if mdev is not None and np.all(np.isfinite(mdev[cols, k])):
+            return mdev[cols, k] ** 2
         mk = m[k : k + 1]
         return mvar_sums(x, mk)[:, 0] / (2.0 * float(mk[0]) ** 2 * (mk[0] / fs) ** 2 * (n_phase - 3 * mk[0] + 1))
 
-    alpha, _ = identify_noise(x, m, adev**2, mvar_of)
-    edf = edf_of(alpha, m, n_phase)
-    edf_m = None
-    if mdev is not None:
-        edf_m = np.where(np.isfinite(mdev), edf_of(alpha, m, n_phase, modified=True), np.nan)
-    return alpha, edf, edf_m
+    alpha[cols], _ = identify_noise(x, m, adev[cols] ** 2, mvar_of)
+    edf[cols] = edf_of(alpha[cols], m, n_phase)
+    if edf_m is not None:
+        edf_m[cols] = np.where(np.isfinite(mdev[cols]), edf_of(alpha[cols], m, n_phase, modified=True), np.nan)
