@@ -206,12 +206,16 @@ class Provenance:
         The job's options as plain JSON values (SI numbers, paths as text).
     version : str
         ``imu-align X.Y.Z``.
+    unit : dict
+        The unit the result is of, as a batch's manifest states it (``serial``, and where given ``station``,
+        ``fixture``, ``operator``, ``device_id``, ``test_time``); empty for a single command's run.
     """
 
     job: str
     files: tuple[InputFile, ...] = ()
     options: dict[str, Any] = field(default_factory=dict)
     version: str = f"imu-align {__version__}"
+    unit: dict[str, str] = field(default_factory=dict)
 
     @classmethod
     def of(cls, job: str, files: Mapping[str, str | Path | None], options: Any) -> Provenance:
@@ -220,7 +224,7 @@ class Provenance:
 
     def to_dict(self) -> dict[str, Any]:
         return {"job": self.job, "files": [f.to_dict() for f in self.files], "options": self.options,
-                "version": self.version}
+                "version": self.version, **({"unit": dict(self.unit)} if self.unit else {})}
 
     @classmethod
     def from_dict(cls, d: Any, where: str = "provenance") -> Provenance:
@@ -230,7 +234,8 @@ class Provenance:
         try:
             files = tuple(InputFile(str(f["role"]), str(f["path"]), int(f["size"]), str(f["sha256"]))
                           for f in d.get("files", []))
-            return cls(str(d["job"]), files, dict(d.get("options") or {}), str(d.get("version", "")))
+            return cls(str(d["job"]), files, dict(d.get("options") or {}), str(d.get("version", "")),
+                       {str(k): str(v) for k, v in dict(d.get("unit") or {}).items()})
         except (KeyError, TypeError, ValueError, AttributeError):
             raise InputError("malformed provenance (job, files with role/path/size/sha256, options, version)",
                              where) from None

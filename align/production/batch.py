@@ -27,7 +27,7 @@ import socket
 import time
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -206,6 +206,8 @@ def run_job(task: Task, files: Callable | None = None,
                 extra = files(result, inputs, task.params)
             else:
                 result, extra = job.run(task.options), []
+            result = result.replace(provenance=replace(result.provenance, unit={"serial": task.unit.serial,
+                                                                                 **dict(task.unit.identity)}))
             with Outputs() as out:  # all or none
                 out.write_json(task.result, result)
                 for path, data in extra:

@@ -32,6 +32,11 @@ def test_the_identity_columns_reach_every_row(tmp_path, run_cli):
     assert a["test_time"] == datetime(2026, 11, 27, 8, 15, tzinfo=UTC)  # the zone honoured, stored in UTC
     assert b["test_time"] == datetime(2026, 11, 27, 10, 0, tzinfo=UTC)
     assert a["time"] - a["test_time"] > timedelta(hours=1)  # the row's time is when it was made, not the test's
+    from align.results import load_result  # the unit's result file says which unit it is of, and reads back
+
+    unit = load_result(out / "units" / "SN0001.matrix.json").provenance.unit
+    assert unit == {"serial": "SN0001", "station": "ST-2", "fixture": "F7", "operator": "kim", "device_id": "2293768",
+                    "test_time": "2026-11-27T09:15:00+01:00"}
 
 
 @pytest.mark.parametrize("value, words", [("2026-11-27 09:15", "states no zone"),
