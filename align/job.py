@@ -105,9 +105,15 @@ class Job(Generic[O, I, R]):
         SHA-256 is computed in the background while the job computes (:func:`align.provenance.start_hashing`)."""
         options = check_options(options)
         limits = read_limits_of(options)  # before the log: a bad limits file costs no computation
-        inputs = self.read(options)
-        start_hashing([p for p in self.files(options).values() if p is not None])
+        inputs = self.read_hashing(options)
         return self.stamp(self.compute(inputs, options, progress), options, limits), inputs
+
+    def read_hashing(self, options: O) -> I:
+        """``self.read(options)``, the input files' SHA-256 started first in the background
+        (:func:`align.provenance.start_hashing`): a long log is hashed beside its decoding and the computation,
+        and :meth:`stamp` takes the digest when it is done."""
+        start_hashing([p for p in self.files(options).values() if p is not None])
+        return self.read(options)
 
 
 def read_limits_of(options: Any) -> Any:

@@ -134,7 +134,7 @@ def allan(
     check_outputs([*logs, limits], json_out=json_out, plot=plot)
     options = allan_options(**params)
     limits_read = read_limits_of(options)  # before the log: a bad limits file costs no reading
-    inputs = ALLAN.read(options)
+    inputs = ALLAN.read_hashing(options)
     with progress(inputs.samples, "Allan deviation (samples read)") as tick:
         result = ALLAN.stamp(ALLAN.compute(inputs, options, tick), options, limits_read)
     extra = allan_files(result, inputs, params)  # all or none: the plot is drawn before anything is written

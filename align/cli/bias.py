@@ -118,7 +118,7 @@ def warmup(
     check_outputs([log, limits], json_out=json_out)
     options = WarmupOptions(log=log, **bias_reading(**params))
     limits_read = read_limits_of(options)
-    inputs = WARMUP.read(options)
+    inputs = WARMUP.read_hashing(options)
     with progress(inputs.samples, "warm-up (samples read)") as tick:
         result = WARMUP.stamp(WARMUP.compute(inputs, options, tick), options, limits_read)
     write_run(json_out, result)
@@ -161,7 +161,7 @@ def repeatability(
     check_outputs([*logs, limits], json_out=json_out)
     options = RepeatabilityOptions(logs=tuple(logs), skip=skip, period=period, level=level, **bias_reading(**params))
     limits_read = read_limits_of(options)
-    inputs = REPEATABILITY.read(options)
+    inputs = REPEATABILITY.read_hashing(options)
     with progress(inputs.samples, "repeatability (samples read)") as tick:
         result = REPEATABILITY.stamp(REPEATABILITY.compute(inputs, options, tick), options, limits_read)
     write_run(json_out, result)
