@@ -297,6 +297,7 @@ def _require(names: list[str] | None, available: list[str], path, time_column: s
 class MissingColumns(InputError):
     """A column asked for is not in the file: ``missing`` the names, ``listed`` the columns there are, shown."""
 
-    def __init__(self, message: str, where: str, missing: list[str], listed: str) -> None:
-        self.missing, self.listed = missing, listed
+    def __init__(self, message: str, where: str | None = None, missing: list[str] | None = None,
+                 listed: str = "") -> None:  # made again from its message alone by a caller that rewords it
+        self.missing, self.listed = list(missing or []), listed
         super().__init__(message, where)
