@@ -64,7 +64,8 @@ Scheduler = Annotated[str | None, typer.Option("--scheduler", metavar="ADDRESS",
 
 
 def batch(
-    manifest: opt.Arg("Manifest: CSV with columns serial, job, log, plan, options and optionally slot, or TOML "
+    manifest: opt.Arg("Manifest: CSV with columns serial, job, log, plan, options and optionally slot, station, "
+                      "fixture, operator, device_id, test_time (ISO 8601 with its zone), or TOML "
                       "([[unit]] tables, [defaults]); paths relative to it. Jobs: matrix (plan: its --plan), "
                       "calibrate ferraris (--sections), calibrate accel (--positions), calibrate mag, calibrate gyro, "
                       "allan; options as the single command takes them.", "MANIFEST"),
@@ -79,7 +80,8 @@ def batch(
 ) -> None:
     """Run every unit of a manifest through its single command (matrix, calibrate ..., allan), in parallel.
 
-    Each unit's result goes to OUT/units/SERIAL.JOB.json, its key figures to OUT/results.parquet (appended). A rerun
+    Each unit's result goes to OUT/units/SERIAL.JOB.json, its key figures to the results store OUT/results.parquet (a
+    folder of Parquet parts, one more per run; read it whole with imu-align lot or pandas.read_parquet). A rerun
     skips units whose result is there and whose inputs are unchanged. Exit status: 0 every unit ran (and passed
     the spec); 3 some units failed or gave an error; 4 some units are outside the spec.
     """

@@ -76,8 +76,9 @@ def batch_summary(run, manifest: str, where: str, table_path, seconds: float) ->
     lines = [f"batch of {manifest} on {where}: {units}; ran {len(ran)}, skipped {len(run.lot()) - len(ran)} "
              f"(done before, inputs unchanged); {len(ok)} ok" + (f" ({len(outside)} outside the spec)" if outside else "")
              + f", {len(failed)} failed, {len(errors)} errors",
-             f"{seconds:.1f} s" + (f", {len(ran) / seconds:.2f} units/s" if ran and seconds > 0 else "")
-             + f"; table {table_path}, results in {table_path.parent / 'units'}"]
+             f"{seconds:.1f} s" + (f", {len(ran) / seconds:.2f} units/s (of the {len(ran)} run)" if ran and seconds > 0
+                                   else "")
+             + f"; results store {table_path}, results in {table_path.parent / 'units'}"]
     bad = failed + errors + outside
     if bad:
         lines.append(f"units not passing ({len(bad)}):")

@@ -101,6 +101,10 @@ def read_table(path: str | Path, columns: Sequence[str] | None = None) -> pa.Tab
         A part is not a lot's Parquet table; a folder holds no part.
     """
     p = Path(path)
+    if p.is_file() and (p.parent.name.startswith("date=") or p.name.startswith("part-")):
+        store = p.parent.parent if p.parent.name.startswith("date=") else p.parent
+        raise InputError(f"is one part of the results store {store}, which holds {len(part_files(store))}; give the "
+                         "store's folder to read every part", str(p))
     files = part_files(p)
     if not files and p.is_dir():
         if any(p.iterdir()):

@@ -49,6 +49,8 @@ def test_appends_make_one_table_every_reader_takes_as_it_is(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["results.parquet"]  # no temporary left
     latest = latest_rows(read_table(path))
     assert [(r["serial"], r["run"]) for r in latest] == [("U1", "r2"), ("U2", "r1")]
+    with pytest.raises(InputError, match="is one part of the results store .*results.parquet, which holds 2"):
+        read_table(path / parts[0])  # a part alone is not the lot
     keys = read_table(path, ["serial", "run", "no_such_column"])  # a resume reads its keys alone
     assert keys.column_names == ["serial", "run"] and keys.num_rows == 3
 

@@ -65,3 +65,14 @@ def test_a_log_read_in_another_unit_does_not_pass(tmp_path, run_cli):
     res = run_cli("verify", result, log_b, "--plan", plan_b, "--gyro-units", "rad/s")
     assert res.code != 0 and "PASS" not in res.out.splitlines()[-1:]
     assert len(res.err.strip().splitlines()) == 1 and "Traceback" not in res.err
+
+
+def test_the_session_the_result_was_fitted_on_is_refused(tmp_path, run_cli):
+    """A PASS on the fitting session itself says nothing (a new user's try): one line naming the session."""
+    (log_a, plan_a), _ = _sessions(tmp_path)
+    result = tmp_path / "r.json"
+    assert run_cli("matrix", log_a, "--plan", plan_a, "--json", result).code == 0
+    res = run_cli("verify", result, log_a, "--plan", plan_a, "--json", tmp_path / "v.json")
+    assert res.code == 2 and len(res.err.strip().splitlines()) == 1 and "fitted on" in res.err
+    assert str(log_a.name) in res.err and not (tmp_path / "v.json").exists()
+

@@ -27,10 +27,11 @@ import numpy as np
 
 from align.alignment.jobs.matrix_job import MatrixInputs, MatrixOptions, read_matrix
 from align.alignment.pipeline import align
-from align.errors import InputError
+from align.errors import InputError, literal
 from align.io.source import LogSource
 from align.job import Job, Progress, fields_signature, quantity
 from align.keyfigures import AXES, figures_from, matrix_figures
+from align.provenance import file_record
 from align.results import Result
 from align.units import DEG
 
@@ -143,15 +144,22 @@ def read_verify(options: VerifyOptions) -> VerifyInputs:
     from align.results import load_result
 
     where = str(options.result)
-    correction = load_result(options.result).correction(options.sensor, where)
-    if str(correction.sensor) != "gyroscope":
-        raise InputError(f"corrects a {correction.sensor}; verify replays a gyro's correction on a rate-table "
-                         "session (give its gyroscope with {sensor})", where)
-    if getattr(correction, "needs_temperature", False):
+    result = load_result(options.result)
+    if result.FORMAT == "imu-align.thermal":
         raise InputError("is a thermal calibration (bias against temperature); verify replays an alignment or a gyro "
                          "calibration on a rate-table session: give one of those, or check a thermal result with "
                          "apply on a held-out log", where)
-    return VerifyInputs(read_matrix(options.matrix_options()), correction)
+    correction = result.correction(options.sensor, where)
+    if str(correction.sensor) != "gyroscope":
+        raise InputError(f"corrects a {correction.sensor}; verify replays a gyro's correction on a rate-table "
+                         "session (give its gyroscope with {sensor})", where)
+    session = read_matrix(options.matrix_options())
+    fitted = {f.sha256 for f in getattr(result.provenance, "files", ()) if f.role == "log" and f.sha256}
+    if fitted and file_record("log", options.log.path).sha256 in fitted:
+        raise InputError(f"is the session {literal(where)} was fitted on (the same bytes as its provenance's log): its "
+                         "residual says nothing of other sessions; verify on another session of the unit",
+                         str(options.log.path))
+    return VerifyInputs(session, correction)
 
 
 def compute_verify(inputs: VerifyInputs, options: VerifyOptions, progress: Progress | None = None) -> VerifyResult:

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from align.calibration.thermal.matrix_t import Calibrated, MatrixThermal, fit_matrix
-from align.errors import InputError
+from align.errors import InputError, literal
 from align.job import Job, Progress, fields_signature
 from align.results import Result, load_result
 
@@ -33,7 +33,7 @@ _NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S*)\s
 
 
 def parse_temperatures(text: str, where: str = "{temperatures}") -> tuple[float, ...]:
-    """Temperatures typed as ``"20 degC,40 degC,60 degC"`` (degC, C, K or degF; a bare number is degC), in degC.
+    """Temperatures typed as ``"20 degC,40 degC,60 degC"`` (degC, C, K or degF; each with its unit), in degC.
 
     Examples
     --------
@@ -48,7 +48,10 @@ def parse_temperatures(text: str, where: str = "{temperatures}") -> tuple[float,
         if m is None:
             raise InputError(f"'{item.strip()}' is not a temperature; give numbers with a unit, separated by commas, "
                              "e.g. '20 degC,40 degC,60 degC'", where)
-        scale, offset = temperature_offset(m.group(2) or "degC", where)
+        if not m.group(2):
+            raise InputError(f"'{item.strip()}' states no unit; give each temperature with its unit, e.g. "
+                             f"'{item.strip()} degC' (or K, degF)", where)
+        scale, offset = temperature_offset(m.group(2), where)
         out.append(round(scale * float(m.group(1)) + offset, 10))
     return tuple(out)
 
@@ -154,10 +157,19 @@ def _read(o: MatrixThermalOptions) -> MatrixThermalInputs:
                          "order", "{temperatures}")
     if o.sensor not in (None, "gyroscope", "accelerometer"):
         raise InputError(f"'{o.sensor}' is not gyroscope or accelerometer", "{sensor}")
-    points, first, mountings = [], None, []
+    points, first, mountings, seen = [], None, [], {}
     for k, path in enumerate(paths):
         where = str(path)
+        data = path.read_bytes() if path.is_file() else None
+        twin = next((w for w, d in seen.items() if data is not None and d == data), None)
+        if twin is not None:
+            raise InputError(f"is given twice (the same bytes as {literal(twin)}): one calibration is one temperature "
+                             "point; give each result once", where)
+        seen[f"{where} (result {k + 1})"] = data
         result = load_result(path)
+        if result.FORMAT == "imu-align.thermal":
+            raise InputError("is a thermal calibration (bias against temperature); thermal-matrix fits calibrations "
+                             "made at several temperatures: give alignment or calibration results", where)
         sensor, units, m, sm, b, sb, mounting = calibration_of(result, o.sensor, where)
         if first is None:
             first = (sensor, units)

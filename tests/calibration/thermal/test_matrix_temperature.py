@@ -228,16 +228,18 @@ def test_the_command_refuses_in_one_line(tmp_path, run_cli, command):
         "equal": ((*files, "--temperatures", "20 degC,20 degC,20 degC,20 degC"), "do not span"),
         "count": ((*files, "--temperatures", "20 degC,40 degC"), "2 temperatures for 4 results"),
         "unit": ((*files[:2], "--temperatures", "20 bananas,40 degC"), "not a temperature unit"),
+        "no unit": ((*files[:2], "--temperatures", "20,40"), "'20' states no unit"),
+        "twice": ((files[0], files[0], files[1], "--temperatures", "0 degC,20 degC,40 degC"), "is given twice"),
         "unstated": ((*files[:2],), "states no session temperature"),
     }
     acc = Calibration("accelerometer", np.eye(3), np.zeros(3), np.full((3, 3), 1e-5), np.full(3, 1e-4), "m/s^2",
                       "six-position")
     save_result(tmp_path / "acc.json", CalibrationSet({"accelerometer": acc}))
-    cases["sensors"] = ((files[0], tmp_path / "acc.json", "--temperatures", "20,40"), "give results of one sensor")
+    cases["sensors"] = ((files[0], tmp_path / "acc.json", "--temperatures", "20 degC,40 degC"), "give results of one sensor")
     counts = Calibration("gyroscope", np.eye(3) * 131, np.zeros(3), np.full((3, 3), 1e-3), np.full(3, 1.0), "counts",
                          "rate table")
     save_result(tmp_path / "counts.json", CalibrationSet({"gyroscope": counts}))
-    cases["units"] = ((files[0], tmp_path / "counts.json", "--temperatures", "20,40"), "counts and physical units")
+    cases["units"] = ((files[0], tmp_path / "counts.json", "--temperatures", "20 degC,40 degC"), "counts and physical units")
     for name, (args, words) in cases.items():
         res = run_cli("calibrate", "thermal-matrix", *args, "--json", tmp_path / "x.json")
         assert res.code != 0 and len(res.err.strip().splitlines()) == 1 and "Traceback" not in res.err, (name, res.err)
@@ -256,7 +258,7 @@ def test_accelerometer_calibrations_holding_both_sensors_take_the_one_chosen(tmp
                           "rate table")
         save_result(tmp_path / f"c{t:g}.json", CalibrationSet({"accelerometer": acc, "gyroscope": gyr}))
         files.append(tmp_path / f"c{t:g}.json")
-    res = run_cli("calibrate", "thermal-matrix", *files, "--temperatures", "0,25,50")
+    res = run_cli("calibrate", "thermal-matrix", *files, "--temperatures", "0 degC,25 degC,50 degC")
     assert res.code == 2 and "--sensor" in res.err and len(res.err.strip().splitlines()) == 1
     out = tmp_path / "acc.json"
     res = run_cli("calibrate", "thermal-matrix", *files, "--temperatures", "273.15 K,25 degC,122 degF", "--sensor",

@@ -135,7 +135,9 @@ def test_verify_refuses_a_thermal_result_naming_it(tmp_path, run_cli):
     assert run_cli("calibrate", "thermal", sim / "thermal.csv", "--temperature-column", "temperature", "--json",
                    result).code == 0
     assert run_cli("simulate", "session", tmp_path / "s").code == 0
-    got = run_cli("verify", result, tmp_path / "s" / "session.csv", "--plan", tmp_path / "s" / "plan.toml",
-                  "--sensor", "gyroscope")
-    assert got.code == 2 and len(got.err.strip().splitlines()) == 1 and "r.json" in got.err
-    assert "thermal calibration" in got.err and "--temperature-column" not in got.err
+    got = run_cli("verify", result, tmp_path / "s" / "session.csv", "--plan", tmp_path / "s" / "plan.toml")
+    assert got.code == 2 and len(got.err.strip().splitlines()) == 1 and "r.json" in got.err  # before --sensor
+    assert "thermal calibration" in got.err and "--temperature-column" not in got.err and "--sensor" not in got.err
+    got = run_cli("calibrate", "thermal-matrix", result, result.with_name("other.json"), "--temperatures",
+                  "20 degC,40 degC")
+    assert got.code == 2 and "r.json: is a thermal calibration" in got.err and "--sensor" not in got.err
