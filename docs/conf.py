@@ -30,6 +30,8 @@ extensions = [
 # autodoc: members in source order, type hints in the signature only (numpydoc's Parameters hold the prose)
 autodoc_member_order = "bysource"
 autodoc_typehints = "signature"
+# a class a package re-exports is documented twice; its annotations name the defining module's
+autodoc_type_aliases = {"ThermalModel": "align.calibration.thermal.model.ThermalModel"}
 autodoc_default_options = {"members": True, "undoc-members": False, "show-inheritance": False}
 autosummary_generate = False  # the pages list their objects; no generated stub pages
 

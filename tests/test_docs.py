@@ -24,7 +24,7 @@ MODULES = [
     "align.calibration.thermal.matrix_t", "align.calibration.thermal.matrix_job",
     "align.job",
     "align.merit", "align.keyfigures", "align.limits", "align.judge",
-    "align.calibration.jobs.positions", "align.calibration.multiposition",
+    "align.calibration.jobs.positions", "align.calibration.multiposition", "align.calibration.gsens",
     "align.noise.warmup", "align.noise.repeatability", "align.noise.bias_jobs",
     "align.production.capability", "align.production.control", "align.production.lotjson",
     "align.production.thermal_groups", "align.production.store", "align.alignment.jobs.verify_job",

@@ -35,6 +35,7 @@ import numpy as np
 
 from align.calibration.accel import StaticDetector, calibrate_accel_free
 from align.calibration.accelfree import widened_level
+from align.calibration.gsens import EARTH_NOTE, g_sensitivity_sigma
 from align.calibration.gyrochecks import (
     MIN_POSES,
     RECOMMENDED_POSES,
@@ -336,8 +337,11 @@ def _gyro_calibration(fit: GyroFit, off: _Offsets, units: str, rotations: list, 
     notes.append("residual of rotation k: the mean reading error over the rotation that would explain the angle "
                  "between the predicted and the measured gravity direction")
     level = widened_level(fit.widening, fit.dof, " for the residual part of M's covariance; the bias's is plain")
+    if off.sigma_K is not None:
+        notes.append(EARTH_NOTE)
     return Calibration("gyroscope", fit.M, off.bias, fit.sigma_M, off.sigma_bias, units, METHOD, fitted, checks,
-                       tuple(notes), off.K, level, tuple(_table(rotations, poses)))
+                       tuple(notes), off.K, level, tuple(_table(rotations, poses)), off.sigma_K)
+
 
 
 def _table(rotations: list, poses: list) -> list[dict]:
@@ -377,6 +381,7 @@ class _Offsets:
     patterns: np.ndarray
     cov: np.ndarray
     rms: float
+    sigma_K: np.ndarray | None = None
 
 
 def _offsets(gyr: np.ndarray, poses: list, force: np.ndarray | None, noise: np.ndarray) -> _Offsets:
@@ -399,4 +404,4 @@ def _offsets(gyr: np.ndarray, poses: list, force: np.ndarray | None, noise: np.n
     columns = np.column_stack([np.ones(n), force])
     patterns = np.stack([columns[:, r, None] * np.eye(3)[j] for r in range(4) for j in range(3)])
     return _Offsets(coef[0], np.sqrt(s2 * xtxi[0, 0]), coef[1:].T, columns @ coef, patterns, cov,
-                    float(np.sqrt(np.mean(resid ** 2))))
+                    float(np.sqrt(np.mean(resid ** 2))), g_sensitivity_sigma(s2, xtxi))

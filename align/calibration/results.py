@@ -72,6 +72,8 @@ class Calibration(Value):
     notes : tuple of str
     g_sensitivity : ndarray, shape (3, 3), optional
         Gyro ``K_ga``, (rad/s) per (m/s^2).
+    sigma_g_sensitivity : ndarray, shape (3, 3), optional
+        Its 1-sigma, when the method states one.
     level : str
         What the 1-sigma is (the file's ``uncertainty.level``): ``"1 sigma"``, or how it was widened for few
         degrees of freedom (the t distribution's 99.73 % bound over 3).
@@ -93,6 +95,7 @@ class Calibration(Value):
     g_sensitivity: np.ndarray | None = None
     level: str = PLAIN_LEVEL
     rotations: tuple = ()
+    sigma_g_sensitivity: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -110,9 +113,16 @@ class Calibration(Value):
         bias, sigma = np.asarray(self.bias, float), np.asarray(self.sigma_bias, float)
         if counts:
             bias, sigma = np.linalg.solve(self.M, bias), sigma / np.abs(np.diag(self.M))
-        return (figures_from(matrix_figures(self.M, self.sigma_M, angle_sigmas_too=True), self.sensor,
-                             method=self.method, counts=counts)
-                + figures_from(vector_figures("bias", bias, sigma), self.sensor, method=self.method))
+        out = (figures_from(matrix_figures(self.M, self.sigma_M, angle_sigmas_too=True), self.sensor,
+                            method=self.method, counts=counts)
+               + figures_from(vector_figures("bias", bias, sigma), self.sensor, method=self.method))
+        if self.g_sensitivity is not None and not counts:  # K_ga: a gyro bias per m/s^2 of specific force
+            k = np.asarray(self.g_sensitivity, float)
+            s = np.full((3, 3), np.nan) if self.sigma_g_sensitivity is None else self.sigma_g_sensitivity
+            values = {f"gsens_{a}{b}": float(k[i, j]) for i, a in enumerate("xyz") for j, b in enumerate("xyz")}
+            values |= {f"gsens_{a}{b}_sigma": float(s[i, j]) for i, a in enumerate("xyz") for j, b in enumerate("xyz")}
+            out += figures_from(values, self.sensor, method=self.method)
+        return out
 
     def to_dict(self) -> dict:
         """The JSON form: matrices dimensionless, readings in ``self.units``."""
@@ -130,6 +140,8 @@ class Calibration(Value):
         if self.g_sensitivity is not None:
             d["g_sensitivity"] = (self.g_sensitivity * to_unit(1.0, u)).tolist()
             d["units"]["g_sensitivity"] = f"{u} per m/s^2"
+            if self.sigma_g_sensitivity is not None:
+                d["uncertainty"]["g_sensitivity"] = (self.sigma_g_sensitivity * to_unit(1.0, u)).tolist()
         if self.rotations:
             d["rotations"] = [dict(r) for r in self.rotations]
         return d
@@ -157,6 +169,8 @@ class Calibration(Value):
                 g_sensitivity=kga,
                 level=str(unc.get("level", PLAIN_LEVEL)),
                 rotations=tuple(_rows(d.get("rotations", []), where)),
+                sigma_g_sensitivity=None if kga is None or unc.get("g_sensitivity") is None else
+                np.array(unc["g_sensitivity"], float).reshape(3, 3) * f,
             )
         except (KeyError, TypeError, ValueError) as exc:
             raise InputError(f"malformed calibration ({malformed(exc)}); regenerate it", where) from None

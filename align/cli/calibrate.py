@@ -27,8 +27,8 @@ COMMANDS: dict[str, Callable[..., Any]] = {"ferraris": ferraris, "accel": accel,
                                            "thermal-matrix": thermal_matrix}
 
 app = typer.Typer(help="Sensor calibration: Ferraris sessions, accelerometer positions, magnetometer ellipsoid, gyro "
-                       "without a rate table, bias against temperature, indexed positions with Earth rate, scale and misalignment "
-                       "against temperature.",
+                       "without a rate table, bias against temperature, indexed positions with Earth rate, scale and "
+                       "misalignment against temperature.",
                   add_completion=False, rich_markup_mode=None, pretty_exceptions_enable=False)
 for _name, _command in COMMANDS.items():
     app.command(_name)(_command)

@@ -7,7 +7,7 @@ were not all characterised in the chamber.
 
 The method
 ----------
-1. Each unit's static bias curve (:meth:`ThermalModel.bias`, no lag term) on a common grid of
+1. Each unit's static bias curve (:meth:`~align.calibration.thermal.model.ThermalModel.bias`, no lag term) on a common grid of
    :data:`POINTS` temperatures spanning the range every unit's model covers (no extrapolation).
 2. Its shape: the curve less its mean over the grid, per axis. The turn-on bias (the curve's level) is each unit's
    own and is not what groups units; a unit compensated with its group's curve keeps its own level.
@@ -140,7 +140,7 @@ def group_thermal(models: Mapping[str, ThermalModel], *, max_groups: int = 6, se
 
     Parameters
     ----------
-    models : mapping of str -> ThermalModel
+    models : mapping of str -> align.calibration.thermal.model.ThermalModel
         Each unit's (serial's) model of one sensor (:meth:`ThermalCalibration.model`).
     max_groups : int
         The most groups tried (fewer when the lot is small: at most ``n // MIN_MEMBERS``).
@@ -222,7 +222,7 @@ def thermal_models(rows: Iterable[dict], folder: str | Path, sensor: str) -> dic
 
     Returns
     -------
-    dict of str -> ThermalModel
+    dict of str -> align.calibration.thermal.model.ThermalModel
         By serial (the latest row's result when a serial has several).
     """
     from align.calibration.thermal.result import ThermalCalibration

@@ -157,7 +157,8 @@ def _read(o: MatrixThermalOptions) -> MatrixThermalInputs:
                          "order", "{temperatures}")
     if o.sensor not in (None, "gyroscope", "accelerometer"):
         raise InputError(f"'{o.sensor}' is not gyroscope or accelerometer", "{sensor}")
-    points, first, mountings, seen = [], None, [], {}
+    points, first, mountings = [], None, []
+    seen: dict[str, bytes | None] = {}
     for k, path in enumerate(paths):
         where = str(path)
         data = path.read_bytes() if path.is_file() else None
