@@ -28,11 +28,11 @@ def _session(seed: int, k_ga: np.ndarray):
 
 @pytest.mark.slow
 def test_k_ga_within_its_reported_sigma_over_seeds():
-    """10 seeds x 9 elements: every K_ga element within 3 of its 1-sigma (one beyond allowed), the off-diagonal
+    """8 seeds x 9 elements: every K_ga element within 3 of its 1-sigma (one beyond allowed), the off-diagonal
     1-sigma covering about 68 % (the diagonal's Earth-rate allowance makes it conservative there, the simulation
     having no Earth rate). Over 24 seeds: 1.00 within 3 sigma, 0.96 within 2, off-diagonal 0.65 within 1."""
     z = []
-    for seed in range(10):
+    for seed in range(8):
         k_true = np.random.default_rng(500 + seed).normal(0, 3e-4, (3, 3))  # (rad/s)/(m/s^2): ~0.17 deg/s per g
         run, q = _session(seed, k_true)
         got = calibrate_gyro_session(run.t, run.acc, run.gyr, "m/s^2", "rad/s", g_sensitivity=True).gyroscope
