@@ -62,11 +62,14 @@ class InputFile:
 
 
 def _sha256(p: Path) -> bytes:
-    """SHA-256 of a file's bytes (read in 1 MiB chunks: bounded memory for a long log)."""
+    """SHA-256 of a file's bytes (read in 1 MiB chunks into one buffer: bounded memory for a long log, and no
+    allocation per chunk, which glibc's per-thread heaps of the hashing threads would keep)."""
     digest = hashlib.sha256()
-    with open(p, "rb") as fh:
-        while block := fh.read(_CHUNK):
-            digest.update(block)
+    buffer = bytearray(_CHUNK)
+    view = memoryview(buffer)
+    with open(p, "rb", buffering=0) as fh:
+        while n := fh.readinto(buffer):
+            digest.update(view[:n])
     return digest.digest()
 
 
@@ -208,7 +211,8 @@ class Provenance:
         ``imu-align X.Y.Z``.
     unit : dict
         The unit the result is of, as a batch's manifest states it (``serial``, and where given ``station``,
-        ``fixture``, ``operator``, ``device_id``, ``test_time``); empty for a single command's run.
+        ``fixture``, ``operator``, ``device_id``, ``test_time``; the last two from the log where the manifest
+        gives none, :mod:`align.production.identity`); empty for a single command's run.
     """
 
     job: str

@@ -27,9 +27,9 @@ from align.cli.batchjobs import (  # noqa: F401
     OUTPUT_OPTIONS,
     RESERVED,
     _jobs,
-    _task_maker,
     check_options,
-    prepare_units,
+    parse_rows,
+    task_maker,
 )
 
 # ---- the worker: the unit's library job ----
@@ -85,6 +85,7 @@ def batch(
     skips units whose result is there and whose inputs are unchanged. Exit status: 0 every unit ran (and passed
     the spec); 3 some units failed or gave an error; 4 some units are outside the spec.
     """
+    import itertools
     import os
     import time
 
@@ -102,27 +103,34 @@ def batch(
                          "its own workers", "{workers}")
     jobs = _jobs()
     lot = read_manifest(manifest, jobs)
-    for unit in lot.units:
+    for unit in lot:
         check_options(unit, str(manifest))
-    pool = make_pool(workers or os.cpu_count() or 1, scheduler, _preload({u.job for u in lot.units}))
-    pool.prestart()  # a fork server's workers start (and import the jobs) while the units are prepared here
+    pool = make_pool(workers or os.cpu_count() or 1, scheduler, _preload(lot.jobs))
+    pool.prestart()  # a fork server's workers start (and import the jobs) while the rows are parsed here
     try:
-        prepared = prepare_units(lot.units, lot.folder.resolve(), str(manifest))
+        parsed = parse_rows(lot, lot.folder.resolve(), str(manifest))
         limits = read_spec(spec) if spec is not None else None
         folder = out if out is not None else lot.folder
         created = output_folder("out", folder)
         folder.mkdir(parents=True, exist_ok=True)
         started = time.perf_counter()
-        run = BatchRun(total=len({u.serial for u in lot.units}))
+        run = BatchRun(total=lot.serials)
         try:
             with locked(folder):
-                tasks, skipped = plan_tasks(lot.units, folder, _task_maker(lot.folder.resolve(), prepared),
-                                            now().isoformat(), rerun=rerun,
-                                            figures=figures_needed(limits) if limits is not None else ())
-                run.add(rejudge_rows(skipped, limits), skipped=True)  # judged again: the spec may be another
-                if tasks:
-                    with pool, progress(len(tasks), "units") as tick:
-                        run_units(tasks, run_unit, pool, folder, lambda rows: judge_rows(rows, limits), tick, run)
+                skipped = [0]
+
+                def skip(rows: list[dict]) -> None:  # judged again: the spec may be another
+                    run.add(rejudge_rows(rows, limits), skipped=True)
+                    skipped[0] += 1
+
+                tasks = plan_tasks(lot, folder, task_maker(lot.folder.resolve(), parsed, str(manifest)),
+                                   now().isoformat(), rerun=rerun,
+                                   figures=figures_needed(limits) if limits is not None else (), skip=skip)
+                first = next(tasks, None)  # every unit skipped: no pool (nor cluster) is started
+                if first is not None:
+                    with pool, progress(len(lot), "units") as tick:
+                        run_units(itertools.chain((first,), tasks), run_unit, pool, folder,
+                                  lambda rows: judge_rows(rows, limits), lambda done: tick(done + skipped[0]), run)
         except BaseException:
             if created and not any(folder.iterdir()):  # nothing ran (no cluster, say): leave no folder behind
                 folder.rmdir()

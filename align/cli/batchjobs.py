@@ -16,7 +16,7 @@ every other input the options name, the ``--axis-down`` captures included).
 
 Public names
 ------------
-JOBS, RESERVED, OUTPUT_OPTIONS, Prepared, check_options, prepare_unit, error_line
+JOBS, RESERVED, OUTPUT_OPTIONS, Prepared, check_options, prepare_unit, parse_rows, task_maker, error_line
 """
 
 from __future__ import annotations
@@ -288,7 +288,7 @@ def prepare_unit(unit, folder: Path, where: str, cache: dict | None = None) -> P
     where : str
         The manifest, for messages.
     cache : dict, optional
-        Rows parsed before (see :func:`prepare_units`).
+        Rows parsed before (see :func:`parse_rows`).
 
     Returns
     -------
@@ -316,21 +316,24 @@ def prepare_unit(unit, folder: Path, where: str, cache: dict | None = None) -> P
     return Prepared(options, {k: _plain(v) for k, v in params.items()} if asked else {}, _hashed(unit, files))
 
 
-def prepare_units(units, folder: Path, where: str) -> dict[tuple[str, str], Prepared]:
-    """:func:`prepare_unit` for every unit, by (serial, job); rows with the same options words parsed once."""
+def parse_rows(units, folder: Path, where: str) -> dict:
+    """Every unit's row parsed by its job's command, rows with the same options words once: a row the command
+    refuses is refused before any unit runs. The parse cache :func:`task_maker` builds each unit's options from."""
     cache: dict = {}
-    return {(u.serial, u.job): prepare_unit(u, folder, where, cache) for u in units}
+    for u in units:
+        _parsed(u, folder, where, cache)
+    return cache
 
 
-def _task_maker(folder: Path, prepared: dict | None = None, where: str | None = None):
-    """``make(unit, result, run) -> Task``: the unit's job and options (``prepared``, or made now)."""
+def task_maker(folder: Path, cache: dict | None = None, where: str | None = None):
+    """``make(unit, result, run) -> Task``: the unit's job and options, built as the unit is taken
+    (:func:`prepare_unit`, its row's parse from ``cache``): the options of a long lot are not all held at once."""
     from align.production import Task
 
-    prepared = {} if prepared is None else prepared
+    cache = {} if cache is None else cache
 
     def make(unit, result: Path, run: str) -> Task:
-        key = (unit.serial, unit.job)
-        got = prepared[key] if key in prepared else prepare_unit(unit, folder, where or str(folder))
+        got = prepare_unit(unit, folder, where or str(folder), cache)
         return Task(unit, result.resolve(), got.inputs, run, got.options, got.params, got.refused)
 
     return make

@@ -43,6 +43,7 @@ from align.errors import InputError, literal
 from align.io.formats import LogFormat
 from align.io.readers import Columns, LogReader, Stream
 from align.io.ulog_format import Join, Layout, Scan, decode, match, sniff, tolerance
+from align.io.ulog_time import GPS, dated, utc_at_boot
 
 __all__ = ["read", "describe", "iter_chunks", "sniff", "READER", "KINDS", "UNITS"]
 
@@ -297,7 +298,7 @@ def _open(path: Path, fmt: LogFormat, names: list[str] | None, time_column: str 
           ) -> tuple[Scan, _Reader, dict[int, list[np.ndarray]]]:
     """Scan a log (keeping the record offsets of the candidate topics when ``keep``); choose the stream."""
     scan, where, starts = Scan(path), str(path), dict[int, list[np.ndarray]]()
-    wanted = _candidates(fmt.topic) if keep else set()
+    wanted = _candidates(fmt.topic) | {GPS} if keep else set()
     for st, key in scan.windows():
         for k in np.unique(key).tolist():
             if scan.keys[k] in wanted:
@@ -331,12 +332,13 @@ def read(path: Path, names: list[str] | None, time_column: str | None, log_forma
     -------
     Columns
         ``data`` (n, len(names)); units, the stream read (``format``, ``topic``, ``instance``,
-        ``device_id``) and remarks (a truncated last message).
+        ``device_id``, and ``time_origin_utc_ns``, the first sample's UTC, when the log has a GPS fix's time) and
+        remarks (a truncated last message).
     """
     scan, reader, starts = _open(path, log_format, names, time_column, keep=True)
     try:
         rows = reader.piece({k: np.concatenate(v) for k, v in starts.items()}, final=True)
-        return reader.columns(rows)
+        return dated(reader.columns(rows), utc_at_boot(scan, starts))
     finally:
         scan.close()
 

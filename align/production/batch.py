@@ -17,7 +17,8 @@ result of other inputs behind.
 
 Public names
 ------------
-Task, BatchRun, plan_tasks, run_units, run_job, unit_rows, result_unit_rows, error_rows, locked, TABLE, UNITS
+Task, plan_tasks, run_units, run_job, unit_rows, result_unit_rows, error_rows, locked, TABLE, UNITS (and BatchRun, from
+:mod:`align.production.batchrun`)
 """
 
 from __future__ import annotations
@@ -32,19 +33,18 @@ from pathlib import Path
 from typing import Any
 
 from align.errors import AlignError, InputError
+from align.production.batchrun import BatchRun
+from align.production.identity import log_identity, unit_identity
 from align.production.keyfigures import result_rows
 from align.production.manifest import Unit, input_hash
-from align.production.store import Journal, read_table
-from align.production.table import META, latest_rows, now
+from align.production.pools import release_memory
+from align.production.store import Journal, LatestRuns, read_table
+from align.production.table import META, now
 
 #: the store's name in the output folder (a folder of Parquet parts, :mod:`align.production.store`)
 TABLE = "results.parquet"
 #: the folder of the units' result files in the output folder
 UNITS = "units"
-#: verdicts from best to worst (a serial's summary is its worst row)
-_RANK = {"pass": 0, "warn": 1, "fail": 2, "failed": 3, "error": 4}
-#: what a :class:`BatchRun` keeps of each row
-KEPT = ("serial", "order", "slot", "job", "sensor", "status", "exit_code", "verdict", "message")
 
 
 @dataclass(frozen=True)
@@ -83,51 +83,6 @@ class Task:
         return input_hash(self.unit.job, self.unit.options, self.inputs, known)
 
 
-@dataclass
-class BatchRun:
-    """What a batch did: the rows of the units it ran, and those of the units it skipped.
-
-    Rows are kept without their figures (:data:`KEPT`; the table has them all): the batch's memory stays flat
-    however long the lot.
-
-    Attributes
-    ----------
-    rows : list of dict
-        One per unit and sensor run now (failed units: one row), in the order they finished.
-    skipped : list of dict
-        The table's latest rows of the units skipped (their result was there with the same inputs).
-    total : int
-        Units (serials) in the manifest.
-    """
-
-    rows: list = field(default_factory=list)
-    skipped: list = field(default_factory=list)
-    total: int = 0
-
-    def add(self, rows: list[dict], skipped: bool = False) -> None:
-        """Keep ``rows`` (of units run now, or with ``skipped`` of units skipped) without their figures."""
-        (self.skipped if skipped else self.rows).extend({k: r.get(k) for k in KEPT} for r in rows)
-
-    @staticmethod
-    def _first(rows: list, status: str | None, verdict: str | None) -> list[dict]:
-        """One row per serial: its worst over its jobs and sensors (error, failed, fail, warn, pass)."""
-        worst: dict[str, dict] = {}
-        for r in rows:
-            have = worst.get(r["serial"])
-            if have is None or _RANK.get(str(r.get("verdict")), 0) > _RANK.get(str(have.get("verdict")), 0):
-                worst[r["serial"]] = r
-        return [r for r in worst.values()
-                if (status is None or r["status"] == status) and (verdict is None or r["verdict"] == verdict)]
-
-    def units(self, status: str | None = None, verdict: str | None = None) -> list[dict]:
-        """One row per unit (serial) run now (its worst), optionally only those of a ``status`` or ``verdict``."""
-        return self._first(self.rows, status, verdict)
-
-    def lot(self, status: str | None = None, verdict: str | None = None) -> list[dict]:
-        """As :meth:`units`, over the units run now and those skipped: the state of the whole lot."""
-        return self._first(self.rows + self.skipped, status, verdict)
-
-
 def _base(task: Task) -> dict:
     u = task.unit
     return {"serial": u.serial, "slot": u.slot, "order": u.order, "run": task.run, "job": u.job,
@@ -145,11 +100,16 @@ def error_rows(task: Task, status: str, exit_code: int, message: str, digest: st
 
 def result_unit_rows(task: Task, result, message: str, digest: str, seconds: float) -> list[dict]:
     """The rows of a unit whose job gave ``result`` (in memory): one per sensor with its figures
-    (:func:`align.production.keyfigures.result_rows`), status ``"ok"``."""
+    (:func:`align.production.keyfigures.result_rows`), status ``"ok"``; the unit's identity completed from its
+    log (:func:`align.production.identity.unit_identity`), a device id other than the manifest's said in the
+    message."""
     stamp = now()
     found = result_rows(result) if result is not None else []
-    return [{**_base(task), "time": stamp, "status": "ok", "exit_code": 0, "message": message, "input_hash": digest,
-             "seconds": seconds, **r} for r in (found or [{"sensor": None, "verdict": "pass", "checks": ""}])]
+    ident, said = unit_identity(dict(task.unit.identity), log_identity(result) if result is not None else {})
+    message = "; ".join(filter(None, [message, said]))
+    return [{**_base(task), **ident, "time": stamp, "status": "ok", "exit_code": 0, "message": message,
+             "input_hash": digest, "seconds": seconds, **r}
+            for r in (found or [{"sensor": None, "verdict": "pass", "checks": ""}])]
 
 
 def unit_rows(task: Task, exit_code: int, message: str, digest: str, seconds: float, result=None) -> list[dict]:
@@ -206,8 +166,8 @@ def run_job(task: Task, files: Callable | None = None,
                 extra = files(result, inputs, task.params)
             else:
                 result, extra = job.run(task.options), []
-            result = result.replace(provenance=replace(result.provenance, unit={"serial": task.unit.serial,
-                                                                                 **dict(task.unit.identity)}))
+            ident, _ = unit_identity(dict(task.unit.identity), log_identity(result))
+            result = result.replace(provenance=replace(result.provenance, unit={"serial": task.unit.serial, **ident}))
             with Outputs() as out:  # all or none
                 out.write_json(task.result, result)
                 for path, data in extra:
@@ -218,19 +178,27 @@ def run_job(task: Task, files: Callable | None = None,
     except Exception as exc:  # the job refused the unit (its exit status), or failed inside (status 1)
         code, message = say(task.unit.job, exc)
         return unit_rows(task, code if code != 0 else 1, message, task.digest(), time.perf_counter() - started)
+    finally:
+        release_memory()  # a worker runs thousands of units: its heap's free pages go back after each
     # the content hash from the bytes the job's provenance hashed (read once), the other inputs read now
     read = {f.path: f.sha256 for f in getattr(result.provenance, "files", ())}
     return result_unit_rows(task, result, "", task.digest(read), time.perf_counter() - started)
 
 
 def plan_tasks(units: Iterable[Unit], out: Path, make: Callable[[Unit, Path, str], Task],
-               run: str, rerun: bool = False, figures: Iterable[str] = ()) -> tuple[list[Task], list[dict]]:
-    """The tasks to run, and the table's latest rows of the units to skip (see the module docstring), the
-    journal of a killed run folded first.
+               run: str, rerun: bool = False, figures: Iterable[str] = (),
+               skip: Callable[[list[dict]], None] | None = None, chunk: int = 256) -> Iterator[Task]:
+    """The tasks to run, made as they are taken, the journal of a killed run folded first; the table's latest
+    rows of each unit skipped (see the module docstring) go to ``skip``.
+
+    Units are taken ``chunk`` at a time: their tasks made, the inputs of those that may be skipped hashed (in
+    threads), the others yielded. Only the store's rows of the manifest's serials are kept, and as Arrow columns:
+    the batch's memory does not grow with the lot or the store's history.
 
     Parameters
     ----------
     units : iterable of Unit
+        Iterated twice (their serials first): a :class:`~align.production.manifest.Manifest` or a sequence.
     out : Path
         The output folder (holding ``units/`` and the table).
     make : callable
@@ -242,25 +210,45 @@ def plan_tasks(units: Iterable[Unit], out: Path, make: Callable[[Unit, Path, str
     figures : iterable of str
         The figures to read of the skipped units' rows (a spec judges them again); the store's other figure
         columns are not read.
+    skip : callable, optional
+        ``skip(rows)``: the latest rows of a unit skipped (its result is there, from the same inputs).
+    chunk : int
+        Units planned at once.
+
+    Yields
+    ------
+    Task
     """
     table_path = out / TABLE
     Journal(table_path).recover()
-    last: dict[tuple[str, str], list[dict]] = {}
     figures = list(figures)
-    for r in latest_rows(read_table(table_path, [n for n, _ in META] + figures), figures):
-        last.setdefault((r["serial"], r["job"]), []).append(r)
-    tasks = [(unit, make(unit, out / UNITS / unit.result_name, run)) for unit in units]
-    done = [] if rerun else [(unit, task) for unit, task in tasks if task.result.exists()
-                             and last.get((unit.serial, unit.job), [{}])[0].get("status") == "ok"]
-    digests = _digests([task for _, task in done])
-    todo, skipped = [], []
-    for unit, task in tasks:
-        prev = last.get((unit.serial, unit.job))
-        if digests.get(id(task)) is not None and prev is not None and prev[0]["input_hash"] == digests[id(task)]:
-            skipped += [{**r, "order": unit.order, "slot": unit.slot} for r in prev]
+    last = LatestRuns(read_table(table_path, [n for n, _ in META] + figures), {u.serial for u in units}, figures)
+    batch: list[tuple[Unit, Task]] = []
+    for unit in units:
+        batch.append((unit, make(unit, out / UNITS / unit.result_name, run)))
+        if len(batch) >= chunk:
+            yield from _sorted(batch, last, rerun, skip)
+            batch = []
+    yield from _sorted(batch, last, rerun, skip)
+
+
+def _sorted(batch: list[tuple[Unit, Task]], last: LatestRuns, rerun: bool,
+            skip: Callable[[list[dict]], None] | None) -> Iterator[Task]:
+    """The tasks of ``batch`` to run; the latest rows of the units skipped to ``skip``."""
+    done = [] if rerun else [task for unit, task in batch if task.result.exists()
+                             and last.status(unit.serial, unit.job) == "ok"]
+    digests = _digests(done)
+    skipped: list[tuple[Unit, list[int]]] = []
+    for unit, task in batch:
+        hashed = digests.get(id(task))
+        if hashed is not None and last.input_hash(unit.serial, unit.job) == hashed:
+            skipped.append((unit, last.at[(unit.serial, unit.job)]))
             continue
-        todo.append(task)
-    return todo, skipped
+        yield task
+    if skip is not None and skipped:  # the skipped units' rows taken from the store at once
+        rows = iter(last.rows([i for _, at in skipped for i in at]))
+        for unit, at in skipped:
+            skip([{**next(rows), "order": unit.order, "slot": unit.slot} for _ in at])
 
 
 def _digests(tasks: list[Task]) -> dict[int, str]:
@@ -275,14 +263,15 @@ def _digests(tasks: list[Task]) -> dict[int, str]:
         return dict(zip(map(id, tasks), ex.map(Task.digest, tasks)))
 
 
-def run_units(tasks: list[Task], worker: Callable[[Task], list[dict]], pool, out: Path,
+def run_units(tasks: Iterable[Task], worker: Callable[[Task], list[dict]], pool, out: Path,
               judge: Callable[[list[dict]], list[dict]] | None = None, progress=None, run: BatchRun | None = None,
               window: int | None = None) -> BatchRun:
     """Run ``tasks`` through ``worker`` on ``pool`` (entered), journaling each unit's rows as it finishes.
 
     Parameters
     ----------
-    tasks : list of Task
+    tasks : iterable of Task
+        Taken as workers free up (a generator: :func:`plan_tasks`).
     worker : callable
         ``worker(task) -> rows`` (picklable: a module-level function).
     pool : ProcessPool or DaskPool
@@ -308,20 +297,21 @@ def run_units(tasks: list[Task], worker: Callable[[Task], list[dict]], pool, out
     (out / UNITS).mkdir(parents=True, exist_ok=True)
     journal = Journal(out / TABLE)
     window = window or max(4, 2 * int(getattr(pool, "workers", None) or 2))
-    pending = list(reversed(tasks))
+    pending = iter(tasks)
     flight: dict = {}
-    done = 0
+    done, more = 0, True
     try:
-        for t in tasks:
-            if t.result.exists():
-                t.result.unlink()  # a result of other inputs, or of a run killed before its row
         for left in (out / UNITS).glob(".*.json.*"):  # temporaries of a run killed while writing (the lock is ours)
             left.unlink(missing_ok=True)
-        while pending or flight:
-            while pending and len(flight) < window:
-                task = pending.pop()
+        while more or flight:
+            while more and len(flight) < window:
+                task = next(pending, None)
+                if task is None:
+                    more = False
+                    break
+                task.result.unlink(missing_ok=True)  # a result of other inputs, or of a run killed before its row
                 flight[pool.submit(worker, task)] = (task, time.perf_counter())
-            for fut in pool.wait(flight):
+            for fut in pool.wait(flight) if flight else ():
                 task, started = flight.pop(fut)
                 rows = _collect(fut, task, started, pool)
                 rows = judge(rows) if judge is not None else rows

@@ -13,7 +13,8 @@ Columns: ``serial`` (names the unit's result file: letters, digits, ``.``, ``_``
 becomes the unit's serial), and optionally ``slot`` (the fixture slot) and the unit's identity: ``station``,
 ``fixture``, ``operator``, ``device_id`` (the sensor's own id, as its log or label states it) and ``test_time``
 (when it was tested, ISO 8601 with its zone: ``2026-11-28T14:05:00+01:00`` or ``...Z``; a trend over test time
-needs it, the table's ``time`` being when the row was made). Paths are relative to the
+needs it, the table's ``time`` being when the row was made; where not given, a log that states them gives
+``device_id`` and ``test_time``, :mod:`align.production.identity`). Paths are relative to the
 manifest's folder. A bad manifest is one :class:`~align.errors.InputError` naming the file, the
 row (CSV line or ``[[unit]]`` number) and the column.
 
@@ -32,7 +33,7 @@ import hashlib
 import io
 import re
 import shlex
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
@@ -51,7 +52,7 @@ OPTIONAL = ("plan", "options", "slot", "station", "fixture", "operator", "device
 IDENTITY = ("station", "fixture", "operator", "device_id", "test_time")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Unit:
     """One unit of a lot, as its manifest row states it (paths resolved against the manifest's folder).
 
@@ -96,15 +97,44 @@ class Unit:
 
 @dataclass(frozen=True)
 class Manifest:
-    """A manifest file and its units, in order."""
+    """A manifest file and its units, in order, each made when asked for.
+
+    The rows are kept checked but compact (their words, the repeated ones shared): a :class:`Unit` with its
+    resolved paths is made as it is iterated, so that a lot of 100,000 units costs the batch a few hundred bytes
+    per unit, not a kilobyte and more.
+    """
 
     path: Path
-    units: tuple[Unit, ...]
+    rows: tuple[tuple, ...]
 
     @property
     def folder(self) -> Path:
         """The folder the manifest's paths are relative to."""
         return self.path.parent
+
+    def __len__(self) -> int:
+        return len(self.rows)
+
+    def __iter__(self) -> Iterator[Unit]:
+        """The units in the manifest's order (:func:`_make` of each checked row)."""
+        folder = self.path.resolve().parent
+        plans: dict[str, Path] = {}
+        return (_make(order, row, folder, plans) for order, row in enumerate(self.rows))
+
+    @property
+    def units(self) -> tuple[Unit, ...]:
+        """Every unit at once (a short manifest; a batch iterates)."""
+        return tuple(self)
+
+    @property
+    def jobs(self) -> frozenset[str]:
+        """The jobs its units name."""
+        return frozenset(r[2] for r in self.rows)
+
+    @property
+    def serials(self) -> int:
+        """How many units (serials) it lists: a serial with several jobs counts once."""
+        return len({r[1] for r in self.rows})
 
 
 def read_manifest(path: str | Path, jobs: Mapping[str, str]) -> Manifest:
@@ -131,18 +161,19 @@ def read_manifest(path: str | Path, jobs: Mapping[str, str]) -> Manifest:
     records = _toml_records(p) if p.suffix.lower() == ".toml" else _csv_records(p)
     if not records:
         raise InputError("lists no units; give one row per unit", str(p))
-    folder = p.resolve().parent
-    units: list[Unit] = []
+    rows: list[tuple] = []
     seen: dict[tuple[str, str], str] = {}
-    for order, (row, record) in enumerate(records):
-        unit = _unit(record, row, order, folder, jobs, str(p))
-        key = (unit.serial.lower(), unit.job)  # case-only differences collide on case-insensitive file systems
+    shared: dict = {}
+    for row, record in records:
+        checked = tuple(shared.setdefault(v, v) for v in _checked(record, row, jobs, str(p)))
+        serial, job = checked[1], checked[2]
+        key = (serial.lower(), job)  # case-only differences collide on case-insensitive file systems
         if key in seen:
-            raise InputError(f"{row}, column serial: {unit.serial} with job {unit.job} is also stated at {seen[key]}; "
+            raise InputError(f"{row}, column serial: {serial} with job {job} is also stated at {seen[key]}; "
                              "give each (serial, job) once (a serial may have several jobs)", str(p))
         seen[key] = row
-        units.append(unit)
-    return Manifest(p, tuple(units))
+        rows.append(checked)
+    return Manifest(p, tuple(rows))
 
 
 def _csv_records(path: Path) -> list[tuple[str, dict]]:
@@ -212,7 +243,9 @@ def _toml_records(path: Path) -> list[tuple[str, dict]]:
     return records
 
 
-def _unit(record: dict, row: str, order: int, folder: Path, jobs: Mapping[str, str], where: str) -> Unit:
+def _checked(record: dict, row: str, jobs: Mapping[str, str], where: str) -> tuple:
+    """A row checked, as the words a :class:`Unit` is made of: ``(row, serial, job, log, plan, options, slot,
+    identity)`` (``log`` and ``plan`` as written, relative to the manifest; ``plan`` ``""`` when not given)."""
     def bad(column: str, what: str) -> InputError:
         return InputError(f"{row}, column {column}: {what}", where)
 
@@ -238,9 +271,17 @@ def _unit(record: dict, row: str, order: int, folder: Path, jobs: Mapping[str, s
         options = tuple(t.replace("{serial}", serial) for t in shlex.split(record.get("options", ""), comments=False))
     except ValueError as exc:
         raise bad("options", f"cannot be split ({exc}); check the quotes") from None
-    slot = record.get("slot") or None
-    return Unit(serial, job, (folder / log).resolve(), (folder / plan).resolve() if plan else None, options, slot,
-                order, row, _identity(record, bad))
+    return row, serial, job, log, plan, options, record.get("slot") or None, _identity(record, bad)
+
+
+def _make(order: int, row: tuple, folder: Path, plans: dict[str, Path]) -> Unit:
+    """The :class:`Unit` of a checked row (:func:`_checked`), its paths resolved against ``folder`` (the plans,
+    often one for the whole lot, resolved once: ``plans``)."""
+    where, serial, job, log, plan, options, slot, identity = row
+    if plan and plan not in plans:
+        plans[plan] = (folder / plan).resolve()
+    return Unit(serial, job, (folder / log).resolve(), plans[plan] if plan else None, options, slot, order, where,
+                identity)
 
 
 def _identity(record: dict, bad) -> tuple[tuple[str, str], ...]:

@@ -7,7 +7,8 @@ The table is read, built and written with pyarrow alone (its file reader, arrays
 
 Columns: :data:`META` (serial, slot, order, run, time (UTC, when the row was made), job, sensor, status,
 exit_code, message, verdict, checks, input_hash, result, seconds, worker, bias_unit, and the unit's identity:
-station, fixture, operator, device_id, test_time (UTC, when the unit was tested, as the manifest states it)),
+station, fixture, operator, device_id, test_time (UTC, when the unit was tested, as the manifest states it, else
+its log: :mod:`align.production.identity`)),
 then every figure of :data:`align.production.keyfigures.FIGURES` (float64, SI; each field's metadata holds its
 unit).
 

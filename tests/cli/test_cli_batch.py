@@ -269,13 +269,13 @@ def test_units_run_in_threads_at_once_keep_their_own_messages(small_lot, tmp_pat
     and the worker touches no stream of the process."""
     from concurrent.futures import ThreadPoolExecutor
 
-    from align.cli.batch import _jobs, _task_maker, run_unit
+    from align.cli.batch import _jobs, task_maker, run_unit
     from align.production import read_manifest
 
     lot, _ = small_lot
     streams = sys.stdout, sys.stderr
     units = read_manifest(lot.manifest, _jobs()).units
-    make = _task_maker(lot.folder.resolve())
+    make = task_maker(lot.folder.resolve())
     (tmp_path / "units").mkdir()
     tasks = [make(u, tmp_path / "units" / f"{u.serial}.json", "r") for u in units] * 3
     wrong = lot.serials("wrong direction")[0]

@@ -92,7 +92,7 @@ def test_options_are_checked_against_the_command_when_the_manifest_is_read(lot3,
 
 
 def test_axis_down_files_resolve_against_the_manifest_and_enter_the_hash(tmp_path, monkeypatch):
-    from align.cli.batch import _jobs, _task_maker, check_options
+    from align.cli.batch import _jobs, task_maker, check_options
 
     data = tmp_path / "data"
     data.mkdir()
@@ -104,7 +104,7 @@ def test_axis_down_files_resolve_against_the_manifest_and_enter_the_hash(tmp_pat
     monkeypatch.chdir(elsewhere)  # a worker's cwd is not the manifest's folder
     unit = read_manifest(os.path.relpath(m, elsewhere), _jobs()).units[0]
     check_options(unit, str(m))
-    make = _task_maker(data.resolve())
+    make = task_maker(data.resolve())
     task = make(unit, tmp_path / "out" / unit.result_name, "r")
     assert task.refused is None  # the job's options, built in this process
     assert dict(task.options.axis_down) == {"x": (data / "xd.csv").resolve(), "y": (data / "yd.csv").resolve(),
@@ -137,7 +137,7 @@ def test_a_foreign_parquet_and_a_bad_scheduler_are_one_line(lot3, tmp_path, run_
 def test_old_spellings_of_options_are_taken_as_the_command_takes_them(tmp_path):
     """``calibrate ferraris --acc-units`` (today --accel-units) in a manifest: the unit's options are the single
     command's."""
-    from align.cli.batch import _jobs, _task_maker, check_options
+    from align.cli.batch import _jobs, task_maker, check_options
     from align.cli.options import ALIASES
 
     old, new = next(iter(ALIASES["calibrate ferraris"].items()))
@@ -149,5 +149,5 @@ def test_old_spellings_of_options_are_taken_as_the_command_takes_them(tmp_path):
         m = _manifest(tmp_path / f"m{k}.csv", row)
         unit = read_manifest(m, _jobs()).units[0]
         check_options(unit, str(m))
-        tasks.append(_task_maker(tmp_path.resolve())(unit, tmp_path / "out" / unit.result_name, "r"))
+        tasks.append(task_maker(tmp_path.resolve())(unit, tmp_path / "out" / unit.result_name, "r"))
     assert tasks[0].refused is None and tasks[0].options == tasks[1].options

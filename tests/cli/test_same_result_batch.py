@@ -153,14 +153,14 @@ def test_every_batch_job_runs_its_library_job(units):
     """No command line inside the worker: every job of a batch has its options builder, and a unit's task holds
     the job's options, built from its row in this process."""
     import align.api as ia
-    from align.cli.batchjobs import JOBS, _jobs, _task_maker, check_options
+    from align.cli.batchjobs import JOBS, _jobs, task_maker, check_options
     from align.cli.builders import BUILDERS
     from align.production import Task, Unit
 
     assert set(_jobs()) == set(JOBS) and set(JOBS) <= set(BUILDERS)
     assert "args" not in Task.__dataclass_fields__
     folder, ok, _ = units
-    make = _task_maker(folder)
+    make = task_maker(folder)
     for k, (serial, job, log, plan, options) in enumerate(ok):
         unit = Unit(serial, job, log, plan, tuple(options), None, k, f"line {k + 2}")
         check_options(unit, "m.csv")

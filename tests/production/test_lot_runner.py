@@ -33,7 +33,7 @@ def test_a_worker_that_dies_costs_its_unit_only(tmp_path, monkeypatch, fork):
     tasks = _tasks(tmp_path, 6)
     with ProcessPool(1) as pool:
         run = run_units(tasks, dying_worker, pool, tmp_path, window=1)
-    rows = {r["serial"]: r for r in run.rows}
+    rows = {r["serial"]: r for r in run.units()}
     assert sorted(rows) == [f"U{k}" for k in range(6)]
     assert rows["U2"]["status"] == "error" and "the worker process died" in rows["U2"]["message"]
     assert all(rows[s]["status"] == "failed" and rows[s]["exit_code"] == 3 for s in rows if s != "U2")
@@ -52,7 +52,7 @@ def test_ctrl_c_in_the_middle_keeps_the_units_done(tmp_path):
         with ProcessPool(2) as pool:
             run_units(tasks, failing_worker, pool, tmp_path, progress=progress, run=run, window=2)
     table = pq.read_table(tmp_path / "results.parquet").to_pandas()  # the journal was folded on the way out
-    assert len(run.units()) == 4 and sorted(table.serial) == sorted(r["serial"] for r in run.rows)
+    assert len(run.units()) == 4 and sorted(table.serial) == sorted(r["serial"] for r in run.units())
     assert not (tmp_path / "results.parquet.journal").exists()
 
 
@@ -122,10 +122,25 @@ def test_a_rerun_skips_the_units_done_with_unchanged_inputs_and_leaves_no_thread
     tasks[3].unit.log.write_bytes(b"time,x\n0,33\n")  # U3's log changed: it runs again
     threads = set(threading.enumerate())  # (a thread of an earlier test may end meanwhile: new ones count)
     by_serial = {t.unit.serial: t for t in tasks}
-    todo, skipped = plan_tasks([t.unit for t in tasks], tmp_path, lambda u, result, run: by_serial[u.serial], "run1")
+    made: list[str] = []
+
+    def make(u, result, run):
+        made.append(u.serial)
+        return by_serial[u.serial]
+
+    def plan(**kw) -> tuple[list, list]:
+        skipped: list[dict] = []
+        todo = list(plan_tasks([t.unit for t in tasks], tmp_path, make, "run1", skip=skipped.extend, chunk=2, **kw))
+        return todo, skipped
+
+    todo, skipped = plan()
     assert [t.unit.serial for t in todo] == ["U3", "U4", "U5"]
     assert [r["serial"] for r in skipped] == ["U0", "U1", "U2"]
+    assert all(r["status"] == "ok" and r["order"] == int(r["serial"][1]) for r in skipped)
     assert not set(threading.enumerate()) - threads
-    todo, skipped = plan_tasks([t.unit for t in tasks], tmp_path, lambda u, result, run: by_serial[u.serial], "run1",
-                               rerun=True)
+    todo, skipped = plan(rerun=True)
     assert len(todo) == 6 and not skipped
+    # the tasks are made as they are taken, a chunk at a time: a long lot's options are not all held at once
+    made.clear()
+    lazy = plan_tasks([t.unit for t in tasks], tmp_path, make, "run1", rerun=True, chunk=2)
+    assert next(lazy).unit.serial == "U0" and made == ["U0", "U1"]

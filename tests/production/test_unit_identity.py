@@ -73,3 +73,79 @@ def test_the_trend_over_time_follows_the_test_time_not_when_the_rows_were_made(t
              "scale_x": 1.0 + 1e-4 * (k / 4)} for k in range(40)]
     (fs,) = lot_statistics(rows, read_spec(tmp_path / "s.toml"), "time").figures
     assert fs.slope == pytest.approx(1e-4) and fs.x[-1] == pytest.approx(39 / 4)
+
+
+# ---- identity from the log (issue 27: "test time from the log where it has one") ----
+
+GYRO_FMT = ("sensor_gyro:uint64_t timestamp;uint64_t timestamp_sample;uint32_t device_id;float x;float y;float z;"
+            "float temperature;uint32_t error_count;")
+GPS_FMT = "vehicle_gps_position:uint64_t timestamp;uint64_t time_utc_usec;int32_t timestamp_time_relative;"
+
+
+def _ulog(path, device: int, utc_boot_us: int | None, seconds: float = 120.0, fs: float = 100.0, seed: int = 0):
+    """A ULog (format from PX4's ULog documentation: header, F, A and D messages) of a static gyro at ``fs``:
+    ``sensor_gyro:0`` of ``device``, from 5 s after power-on; with ``utc_boot_us``, GPS fixes dating the log
+    (``time_utc_usec`` at ``timestamp + timestamp_time_relative``)."""
+    import struct
+
+    import numpy as np
+
+    out = bytearray(b"ULog\x01\x12\x35\x01" + struct.pack("<Q", 0))
+
+    def msg(kind: str, body: bytes) -> None:
+        out.extend(struct.pack("<HB", len(body), ord(kind)) + body)
+
+    msg("B", bytes(40))
+    msg("F", GYRO_FMT.encode())
+    msg("F", GPS_FMT.encode())
+    msg("A", struct.pack("<BH", 0, 1) + b"sensor_gyro")
+    msg("A", struct.pack("<BH", 0, 2) + b"vehicle_gps_position")
+    rng = np.random.default_rng(seed)
+    w = rng.normal(0, 2e-3, (int(seconds * fs), 3)) + [1e-3, -2e-3, 5e-4]
+    for k, row in enumerate(w):
+        t = 5_000_000 + int(k * 1e6 / fs)
+        msg("D", struct.pack("<H", 1) + struct.pack("<QQI4fI", t + 300, t, device, *row, 35.0, 0))
+        if utc_boot_us is not None and k % int(fs) == 50:  # a fix a second, published 20 ms after its time
+            msg("D", struct.pack("<H", 2) + struct.pack("<QQi", t + 20_000, utc_boot_us + t, -20_000))
+    path.write_bytes(bytes(out))
+    return path
+
+
+def test_device_id_and_test_time_from_the_log_where_the_manifest_gives_none(tmp_path, run_cli):
+    from align.results import load_result
+
+    boot = int(datetime(2026, 5, 4, 7, 30, 0, tzinfo=UTC).timestamp() * 1e6)
+    _ulog(tmp_path / "a.ulg", 2424842, boot)
+    _ulog(tmp_path / "b.ulg", 3670050, None, seed=1)  # no GPS: no test time
+    _ulog(tmp_path / "c.ulg", 2621474, boot + 3_600_000_000, seed=2)
+    manifest = tmp_path / "m.csv"
+    manifest.write_text("serial,job,log,options,device_id,test_time\n"
+                        "A1,allan,a.ulg,--topic sensor_gyro:0,,\n"
+                        "B1,allan,b.ulg,--topic sensor_gyro:0,,\n"
+                        "C1,allan,c.ulg,--topic sensor_gyro:0,999,2026-05-04T12:00:00+02:00\n")
+    res = run_cli("batch", manifest, "--out", tmp_path / "out", "--workers", 1)
+    assert res.code == 0, res.err + res.out
+    rows = {r["serial"]: r for r in latest_rows(read_table(tmp_path / "out" / "results.parquet"))}
+    a, b, c = rows["A1"], rows["B1"], rows["C1"]
+    first = datetime(2026, 5, 4, 7, 30, 5, tzinfo=UTC)  # the first sample, 5 s after power-on
+    assert (a["device_id"], a["test_time"]) == ("2424842", first)
+    assert (b["device_id"], b["test_time"]) == ("3670050", None)
+    # the manifest wins; a log of another device id is said in the unit's message
+    assert (c["device_id"], c["test_time"]) == ("999", datetime(2026, 5, 4, 10, 0, tzinfo=UTC))
+    assert "the log states device id 2621474, the manifest 999" in c["message"] and not a["message"]
+    assert load_result(tmp_path / "out" / "units" / "A1.allan.json").provenance.unit == {
+        "serial": "A1", "device_id": "2424842", "test_time": first.isoformat()}
+
+
+def test_a_clock_since_power_on_dates_nothing():
+    from types import SimpleNamespace
+
+    from align.production.identity import log_identity
+
+    now = int(datetime(2026, 11, 29, tzinfo=UTC).timestamp()) * 10**9
+    bag = SimpleNamespace(inputs={"stream": {"time_origin_ns": 1_700_000_000 * 10**9}})  # 2023-11-14T22:13:20Z
+    assert log_identity(bag, now) == {"test_time": "2023-11-14T22:13:20+00:00"}
+    for origin in (12 * 10**9, now + 2 * 86_400 * 10**9):  # since power-on; in the future
+        assert log_identity(SimpleNamespace(inputs={"stream": {"time_origin_ns": origin}}), now) == {}
+    runs = SimpleNamespace(inputs={"streams": [{"units_stated": "rad/s"}, {"stream": {"device_id": 7}}]})
+    assert log_identity(runs, now) == {"device_id": "7"}
