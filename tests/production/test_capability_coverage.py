@@ -47,7 +47,7 @@ def _coverage(name: str, n: int, lots: int = 200, resamples: int = 1000, seed: i
     boot = percentile_cpk(bootstrap_quantiles(x, resamples, rng), low, high)  # (lots, resamples)
     a, b = np.nanpercentile(boot, [2.5, 97.5], axis=1)
     true = _true_cpk(q, low, high)
-    return true, float(np.mean((a <= true) & (true <= b))), float(np.median(est))
+    return true, float(np.mean((a <= true) & (true <= b))), float(np.median(est)), float(np.mean(a > true))
 
 
 def test_the_exact_order_statistic_bootstrap_is_the_resampling_bootstrap():
@@ -66,7 +66,7 @@ def test_the_exact_order_statistic_bootstrap_is_the_resampling_bootstrap():
 
 def test_a_skewed_lot_of_3000_is_covered():
     """The case that undercovered (0.83-0.87 with the tails read 5 units from the end at a fixed step)."""
-    true, cover, median = _coverage("lognormal", 3000)
+    true, cover, median, _ = _coverage("lognormal", 3000)
     assert cover >= 0.93, (true, cover)
     assert abs(median / true - 1) < 0.05
 
@@ -77,3 +77,12 @@ def test_percentile_cpk_coverage_skewed_and_bimodal_at_100_1000_3000():
     got = {(name, n): _coverage(name, n) for name in CASES for n in (100, 1000, 3000)}
     bad = {k: v for k, v in got.items() if v[1] < 0.93}
     assert not bad, bad
+
+
+@pytest.mark.slow
+def test_a_bimodal_lot_of_300_misses_only_on_the_safe_side():
+    """The gap capability.py's docstring states: a bimodal lot of 300 units is covered in 0.79-0.86 (two seeds), its
+    interval below the truth every time it misses, so that its lower bound holds at its one-sided 97.5 %."""
+    for seed in (7, 8):
+        true, cover, median, above = _coverage("bimodal", 300, seed=seed)
+        assert above <= 0.025 and cover >= 0.75 and median < true, (seed, cover, above, median / true)

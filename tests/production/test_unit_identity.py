@@ -149,3 +149,24 @@ def test_a_clock_since_power_on_dates_nothing():
         assert log_identity(SimpleNamespace(inputs={"stream": {"time_origin_ns": origin}}), now) == {}
     runs = SimpleNamespace(inputs={"streams": [{"units_stated": "rad/s"}, {"stream": {"device_id": 7}}]})
     assert log_identity(runs, now) == {"device_id": "7"}
+
+
+def test_an_euroc_folder_of_epoch_stamps_dates_its_unit(tmp_path, run_cli):
+    # an ASL (EuRoC) dataset's data.csv: "#timestamp [ns]" since 1970 (MH_01_easy's first stamp: 2014-06-24)
+    import numpy as np
+
+    imu = tmp_path / "MH" / "mav0" / "imu0"
+    imu.mkdir(parents=True)
+    first = 1403636579758555392
+    rng = np.random.default_rng(3)
+    rows = ["#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],a_RS_S_x [m s^-2],"
+            "a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]"]
+    for k in range(12_000):  # 60 s at 200 Hz, at rest
+        g, a = rng.normal(0, 2e-3, 3), rng.normal([0, 0, 9.81], 0.02, 3)
+        rows.append(",".join([str(first + 5_000_000 * k), *(f"{v:.6g}" for v in (*g, *a))]))
+    (imu / "data.csv").write_text("\n".join(rows) + "\n")
+    (tmp_path / "m.csv").write_text("serial,job,log\nE1,allan,MH/mav0\n")
+    res = run_cli("batch", tmp_path / "m.csv", "--out", tmp_path / "out", "--workers", 1)
+    assert res.code == 0, res.err + res.out
+    (row,) = latest_rows(read_table(tmp_path / "out" / "results.parquet"))
+    assert row["test_time"] == datetime(2014, 6, 24, 19, 2, 59, 758555, tzinfo=UTC) and row["device_id"] is None
