@@ -380,7 +380,8 @@ def lot_report_html(stats, source: str, thermal: tuple = ()) -> str:
             sections.append(Section("Capability", "<ul>" + "".join(f"<li>{esc(c)}</li>" for c in cap) + "</ul>"
                                     + '<p class="note">Cpk shown: the normal one unless an Anderson-Darling test rejects '
                                     "normality (alpha 0.05); then the percentile Cpk of ISO 22514-2 (each tail a Johnson "
-                                    "fit; 95 % percentile bootstrap interval).</p>"))
+                                    "fit; 95 % percentile bootstrap interval, its top raised to a far-tail reading's where "
+                                    "higher).</p>"))
         sig = signal_lines(stats)
         if sig:
             sections.append(Section("Control-chart signals", "<ul>" + "".join(f"<li>{esc(c)}</li>" for c in sig)

@@ -28,21 +28,24 @@ quantile beyond about the fifth unit from either end enters, so one wild unit do
 The interval
 ------------
 A percentile bootstrap (Efron): :data:`BOOTSTRAP` resamples of the lot with replacement, drawn from
-``numpy.random.default_rng(seed)`` (seeded: the same lot gives the same interval), each refitted; the 2.5 and 97.5 %
-points of their Cpk_pct are the 95 % interval. Only the order statistics the fit reads are drawn, exactly in
+``numpy.random.default_rng(seed)`` (seeded: the same lot gives the same interval), each refitted; the 2.5 % point
+of their Cpk_pct is the 95 % interval's lower end, and its upper end is the larger of their 97.5 % point and that
+of a far-tail reading's bootstrap (each tail's lowest quantile at the 69 % point or beyond, :func:`far_step`;
+:func:`percentile_interval`). Only the order statistics the fit reads are drawn, exactly in
 distribution (:func:`bootstrap_quantiles`), so a resample costs the same at 100 as at 3,000 units. Measured over 200
-simulated lots per case (lognormal, gamma, a two-mode normal mixture at 100, 1,000 and 3,000 units;
-``tests/production/test_capability_coverage.py``; four seeds) it covers the analytic truth in 96.5 to 100 % of
-lots (conservative at small lots). The bimodal lot of 175 to 400 units is covered in only 79 to 95 % (300 units:
-79 and 86 %), its tails' lowest quantiles in the mixture's valley: every miss lies below the truth (the estimate
--15 %), so its lower bound, the one a capability claim rests on, holds at 97.5 % or more; reading the tails from
-further out cures the coverage but biases every lot's Cpk low by 15 to 35 % (tried, not adopted). Reading each tail 5 units from the end
-at a fixed step undercovered large lots (83 to 90 % at 3,000 skewed units, 88 to 92 % at 1,000 bimodal ones): the
-fit's bias then outgrew the interval. A type 7 quantile ``k`` units from the end reads a tail of probability about
-``(k + 1) / n``, not ``k / n`` (+20 % at ``k = 5``: the 99.865 % point extrapolated low, Cpk +2 to +4 % on the
-lognormal lot), and a bimodal lot's lowest tail quantile fell in its valley; reading 12 units from the end at a step
-of 0.3 cuts both. Its width states honestly how little a lot says about a 0.135 % point (about +/-40 % of Cpk at
-200 units, +/-15 to 30 % at 1,000).
+simulated lots per case (lognormal, gamma, a two-mode normal mixture at 100, 200, 300, 400, 1,000 and 3,000
+units; ``tests/production/test_capability_coverage.py``; two seeds) it covers the analytic truth in 97 to 100 % of
+lots, its lower end above the truth in at most 2.5 %. The far reading's top is there for the bimodal lot of 175 to
+400 units: the lot's own reading alone covered it in 79 to 95 % (300 units: 79 and 86 %), its tails' lowest
+quantiles in the mixture's valley, every miss below the truth (the estimate -15 %); the far reading alone covers it
+but biases every lot's Cpk low by 15 to 35 %, so it only raises the top (by 0 to 17 %, median), never the lower end
+a capability claim rests on. Reading each tail 5 units from the end at a fixed step undercovered large lots (83 to
+90 % at 3,000 skewed units, 88 to 92 % at 1,000 bimodal ones): the fit's bias then outgrew the interval. A type 7
+quantile ``k`` units from the end reads a tail of probability about ``(k + 1) / n``, not ``k / n`` (+20 % at
+``k = 5``: the 99.865 % point extrapolated low, Cpk +2 to +4 % on the lognormal lot), and a bimodal lot's lowest
+tail quantile fell in its valley; reading 12 units from the end at a step of 0.3 cuts both. Its width states
+honestly how little a lot says about a 0.135 % point (the lower end 35 to 50 % of Cpk below the estimate at 200
+units, 15 to 30 % at 1,000).
 
 The decision
 ------------
@@ -52,13 +55,14 @@ normality is not rejected, else the percentile Cpk, and the normal one is flagge
 
 Public names
 ------------
-Capability, capability, percentile_cpk, tail_quantiles, bootstrap_quantiles, tail_centre, tail_step,
-anderson_darling, ALPHA, BOOTSTRAP, MIN_N
+Capability, capability, percentile_cpk, percentile_interval, tail_quantiles, bootstrap_quantiles, tail_centre,
+tail_step, far_step, anderson_darling, ALPHA, BOOTSTRAP, MIN_N
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -81,6 +85,8 @@ STEP_LARGE = 0.3
 FROM_END, FROM_END_PER = (5.0, 12.0), 250.0
 #: the normal score of the 99.865 % point
 Z3 = 3.0
+#: the far-tail reading's lowest quantile: normal score 0.5, the 69 % point (:func:`far_step`)
+FAR_FLOOR = 0.5
 
 
 def _johnson_at(q: np.ndarray, step: float, z: float) -> np.ndarray:
@@ -233,6 +239,57 @@ def bootstrap_quantiles(sorted_values: np.ndarray, resamples: int, rng: np.rando
     return _from_order(at, g, step, Z3 - z0)
 
 
+def far_step(n: int) -> float:
+    """The step of the far-tail reading of a lot of ``n`` (:func:`percentile_interval`): at most :func:`tail_step`'s,
+    and small enough that a tail's lowest quantile is at normal score :data:`FAR_FLOOR` (the 69 % point) with its top
+    one ``k`` units from the end (:func:`tail_centre`).
+
+    >>> round(far_step(100), 3), round(far_step(300), 3), far_step(3000)
+    (0.191, 0.271, 0.3)
+    """
+    from scipy.special import ndtri
+
+    k = float(np.clip(n / FROM_END_PER, *FROM_END))
+    return min(tail_step(n), float(ndtri(1 - k / max(n, k + 1)) - FAR_FLOOR) / 6)
+
+
+def percentile_interval(sorted_values: np.ndarray, low: float | None, high: float | None, resamples: int,
+                        rng: np.random.Generator, level: float = 0.95) -> tuple[np.ndarray, float]:
+    """The percentile Cpk's interval ``(lower, upper)`` at ``level`` and the fraction of the lot's bootstrap
+    resamples whose tails could be fitted (module docstring, "The interval").
+
+    The lower end is the ``(1 - level) / 2`` point of the bootstrap of the lot's own reading (:func:`tail_quantiles`);
+    the upper end is the larger of that bootstrap's ``(1 + level) / 2`` point and that of a far-tail reading
+    (:func:`far_step`), drawn next from ``rng``.
+
+    Parameters
+    ----------
+    sorted_values : ndarray, shape (n,) or (L, n)
+        A lot (or L lots) sorted ascending.
+    low, high : float or None
+    resamples : int
+    rng : numpy.random.Generator
+    level : float
+
+    Returns
+    -------
+    ends : ndarray, shape (2,) or (2, L)
+    valid : float
+        The fraction of the lot's own reading's resamples with a finite Cpk (of all lots).
+    """
+    x = np.asarray(sorted_values, float)
+    n = x.shape[-1]
+    tail = 100 * (1 - level) / 2
+    boot = percentile_cpk(bootstrap_quantiles(x, resamples, rng), low, high)
+    step = far_step(n)
+    far = percentile_cpk(bootstrap_quantiles(x, resamples, rng, z0=tail_centre(n, step), step=step), low, high)
+    with warnings.catch_warnings():  # a lot whose every resample failed: NaN ends, said by ``valid``
+        warnings.simplefilter("ignore", RuntimeWarning)
+        lo, hi = np.nanpercentile(boot, [tail, 100 - tail], axis=-1)
+        hi = np.fmax(hi, np.nanpercentile(far, 100 - tail, axis=-1))
+    return np.array([lo, hi]), float(np.mean(np.isfinite(boot)))
+
+
 def percentile_cpk(quantiles: np.ndarray, low: float | None, high: float | None) -> np.ndarray:
     """``min((USL - X50) / (X99.865 - X50), (X50 - LSL) / (X50 - X0.135))`` of quantiles ``(X0.135, X50, X99.865)``
     (shape (3,) or (3, B)); a side without a limit is left out (ISO 22514-2, the percentile method).
@@ -371,11 +428,9 @@ def capability(values: np.ndarray, low: float | None, high: float | None, *, alp
         q = (lo_q, med_q, hi_q)
         cp = float(percentile_cpk(np.array(q), low, high))
         if math.isfinite(cp):
-            boot = percentile_cpk(bootstrap_quantiles(np.sort(x), resamples, np.random.default_rng(seed)), low, high)
-            good = boot[~np.isnan(boot)]
-            if len(good) >= 0.95 * resamples:
-                tail = 100 * (1 - level) / 2
-                ci = (float(np.percentile(good, tail)), float(np.percentile(good, 100 - tail)))
+            ends, valid = percentile_interval(np.sort(x), low, high, resamples, np.random.default_rng(seed), level)
+            if valid >= 0.95:
+                ci = (float(ends[0]), float(ends[1]))
     if not p < alpha:
         why = (f"normal: Anderson-Darling p {_p(p)} >= {alpha:g}, normality not rejected" if math.isfinite(p)
                else f"normal: too few units ({n}) to test normality" if n < MIN_N_TEST
