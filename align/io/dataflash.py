@@ -198,8 +198,8 @@ def read(path: Path, names: list[str] | None, time_column: str | None, log_forma
     -------
     Columns
         ``data`` (n, k) float64; ``units`` as the log states them (``time`` s); ``source``
-        ``{"format": "dataflash", "topic": "IMU", "instance": k}``; ``notes`` on a cut last record or
-        skipped bytes.
+        ``{"format": "dataflash", "topic": "IMU", "instance": k}``, with ``time_origin_utc_ns`` (the first sample's
+        UTC) when the log has GPS records with a week; ``notes`` on a cut last record or skipped bytes.
 
     Raises
     ------
@@ -227,8 +227,29 @@ def read(path: Path, names: list[str] | None, time_column: str | None, log_forma
     for j, n in enumerate(wanted):
         label, _, factor = columns[n]
         np.multiply(raw[label], factor, out=data[j])
-    return Columns(wanted, data.T, {n: columns[n][1] for n in wanted},
-                   {"format": "dataflash", "topic": "IMU", "instance": imu.instance}, log.notes())
+    source = {"format": "dataflash", "topic": "IMU", "instance": imu.instance}
+    boot = _utc_at_boot(log)
+    if boot is not None and "time" in wanted and len(imu.positions):  # the first sample's UTC, from the GPS
+        source["time_origin_utc_ns"] = int(boot + round(float(data[wanted.index("time"), 0]) * 1e6)) * 1000
+    return Columns(wanted, data.T, {n: columns[n][1] for n in wanted}, source, log.notes())
+
+
+def _utc_at_boot(log: _Log) -> int | None:
+    """UTC (us since 1970) of the log's time zero from its ``GPS`` records: ``GWk`` and ``GMS`` (the fix's GPS
+    week and milliseconds, ArduPilot's log message documentation) at ``TimeUS`` (or ``TimeMS``), GPS time made UTC
+    (:func:`align.io.gpstime.gps_utc_us`); the median over the records with a week; None without."""
+    from align.io.gpstime import gps_utc_us
+
+    t = log.layout.by_name.get("GPS", -1)
+    f = log.layout.formats.get(t)
+    clock = next((c for c in ("TimeUS", "TimeMS") if f is not None and c in f.labels), None)
+    if f is None or clock is None or not f.decodable or not {"GWk", "GMS"} <= set(f.labels):
+        return None
+    rec = decode(log.buf, f, log.layout.of(t), [clock, "GWk", "GMS"])
+    at = rec[clock].astype(np.int64) * (1000 if clock == "TimeMS" else 1)
+    utc = gps_utc_us(rec["GWk"], rec["GMS"])
+    ok = (rec["GWk"] > 0) & (utc > 0)
+    return int(np.median(utc[ok] - at[ok])) if ok.any() else None
 
 
 def describe(path: Path, log_format: LogFormat) -> list[Stream]:

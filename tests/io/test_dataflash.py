@@ -345,3 +345,26 @@ def test_the_modules_examples_run():
     for module in (dataflash, dataflash_format):
         failed, tried = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
         assert tried and not failed
+
+
+def test_gps_records_date_the_stream_in_utc(tmp_path):
+    """ArduPilot's GPS message (TimeUS, I, Status, GMS, GWk, ...: GPS week and ms of the week, since 1980-01-06
+    without leap seconds): the first IMU sample's UTC from them, 18 leap seconds taken off (IERS Bulletin C)."""
+    from datetime import UTC, datetime, timedelta
+
+    w = Writer()
+    truth = new_log(w, n=40)
+    w.define(130, "GPS", "QBBIHBcLLeffffB", "TimeUS,I,Status,GMS,GWk,NSats,HDop,Lat,Lng,Alt,Spd,GCrs,VZ,Yaw,U")
+    first = datetime(2024, 2, 6, 12, 0, 0, tzinfo=UTC)  # the UTC of the first IMU sample of instance 0 (at 5 s)
+    for stamp in (6_000_000, 7_000_000, 8_000_000):  # fixes 1, 2, 3 s after it
+        since = first + timedelta(microseconds=stamp - 5_000_000) - datetime(1980, 1, 6, tzinfo=UTC)
+        gps_ms = round((since.total_seconds() + 18) * 1000)  # UTC + 18 s = GPS time (2017 on)
+        w.write("GPS", stamp, 0, 3, gps_ms % 604_800_000, gps_ms // 604_800_000, 12, 90, 0, 0, 0, 0.0, 0.0, 0.0,
+                0.0, 1)
+    w.write("GPS", 9_000_000, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0.0, 0.0, 0.0, 0.0, 1)  # no fix: week 0, left out
+    path = w.save(tmp_path / "gps.bin")
+    assert read(path, "IMU:0").source["time_origin_utc_ns"] == int(first.timestamp()) * 10**9
+    later = int((first + timedelta(microseconds=100)).timestamp() * 1e6) * 1000  # instance 1 starts 100 us later
+    assert read(path, "IMU:1").source["time_origin_utc_ns"] == later
+    assert "time_origin_utc_ns" not in read(path, "IMU:0", ["gyro_x"]).source  # no time column read
+    assert truth[0]["TimeUS"][0] == 5_000_000

@@ -1,0 +1,53 @@
+"""GPS time (week and milliseconds of the week) as UTC: what dates a flight controller's log.
+
+GPS time counts from 1980-01-06T00:00:00Z without leap seconds; UTC has had leap seconds inserted since, so
+``UTC = GPS epoch + GPS seconds - (GPS - UTC)``, the offset from IERS Bulletin C (:data:`LEAP`: 18 s since
+2017-01-01). A log's clock (microseconds since power-on) is tied to UTC by a record holding both.
+
+Public names
+------------
+gps_utc_us, LEAP, GPS_EPOCH_US
+"""
+
+from __future__ import annotations
+
+from datetime import UTC, datetime
+
+import numpy as np
+
+__all__ = ["gps_utc_us", "LEAP", "GPS_EPOCH_US"]
+
+#: 1980-01-06T00:00:00Z in microseconds since 1970
+GPS_EPOCH_US = int(datetime(1980, 1, 6, tzinfo=UTC).timestamp()) * 1_000_000
+#: (UTC from which, GPS - UTC in s): the leap seconds of IERS Bulletin C from 1999 on
+LEAP = ((datetime(1999, 1, 1, tzinfo=UTC), 13), (datetime(2006, 1, 1, tzinfo=UTC), 14),
+        (datetime(2009, 1, 1, tzinfo=UTC), 15), (datetime(2012, 7, 1, tzinfo=UTC), 16),
+        (datetime(2015, 7, 1, tzinfo=UTC), 17), (datetime(2017, 1, 1, tzinfo=UTC), 18))
+
+
+def gps_utc_us(week: np.ndarray, ms: np.ndarray) -> np.ndarray:
+    """UTC (us since 1970) of GPS times given as ``week`` (since 1980-01-06) and ``ms`` of the week; -1 before 1999
+    (an offset this table does not hold).
+
+    Parameters
+    ----------
+    week, ms : array_like, shape (n,)
+
+    Returns
+    -------
+    ndarray, shape (n,), int64
+
+    Examples
+    --------
+    GPS week 2300, 216,018 s into it: 2024-02-06T12:00:00Z (18 leap seconds).
+
+    >>> us = int(gps_utc_us(np.array([2300]), np.array([216_018_000]))[0])
+    >>> datetime.fromtimestamp(us / 1e6, UTC).isoformat()
+    '2024-02-06T12:00:00+00:00'
+    """
+    gps = GPS_EPOCH_US + np.asarray(week, np.int64) * 604_800_000_000 + np.asarray(ms, np.int64) * 1000
+    out = np.full(gps.shape, -1, np.int64)
+    for since, offset in LEAP:  # later entries overwrite: the offset in force at each time
+        utc = gps - offset * 1_000_000
+        out = np.where(utc >= int(since.timestamp()) * 1_000_000, utc, out)
+    return out
