@@ -6,9 +6,10 @@ the log's reader, :class:`align.io.readers.Columns`; an Allan analysis's ``strea
 
 * ``device_id``: the stream's own (a PX4 ULog's ``device_id`` field, ``sensor_gyro:N`` and the like);
 * ``test_time``: the UTC of the first sample, from ``time_origin_utc_ns`` (a reader that dates its log from a
-  GPS fix: a ULog's ``vehicle_gps_position``, a DataFlash log's ``GPS`` week and milliseconds), else from ``time_origin_ns`` when that is a date, between
-  2000-01-01 and a day from now (a ROS bag's or an EuRoC folder's stamps, nanoseconds since 1970 when the
-  recorder's clock is the wall clock; a simulated clock starts near zero and dates nothing).
+  GPS fix: a ULog's ``vehicle_gps_position``, a DataFlash log's ``GPS`` week and milliseconds), else from
+  ``time_origin_ns`` when that is a date, between 2000-01-01 and a day from now (a ROS bag's or an EuRoC folder's
+  stamps, nanoseconds since 1970 when the recorder's clock is the wall clock; a simulated clock starts near zero
+  and dates nothing).
 
 The manifest's value wins; a log that states another device id is said in the unit's message (the wrong log
 for a serial, or a label that is wrong).

@@ -403,5 +403,9 @@ def lot_statistics(rows: list[dict], spec: Spec | None = None, trend_by: str = "
                      else "no job of theirs gives it (or it is NaN: not identifiable)")
                   + f" (e.g. {', '.join(who[:3])}); they do not count as passing"
                   for (key, figure, why), who in missing.items())
+    spread = [x for x in xs.values() if math.isfinite(x)]
+    if trend_by == "time" and spread and max(spread) == min(spread):
+        notes += ("no trend over time: every unit has the same test time (the manifest's test_time, or the log's, "
+                  "else when its row was made); give each unit its own, or trend over the lot's order",)
     ordered = sorted(units, key=lambda u: (u.verdict == "pass", u.order, u.serial))
     return LotStats(figures, tuple(ordered), trend_by, spec, notes)

@@ -269,7 +269,7 @@ def test_units_run_in_threads_at_once_keep_their_own_messages(small_lot, tmp_pat
     and the worker touches no stream of the process."""
     from concurrent.futures import ThreadPoolExecutor
 
-    from align.cli.batch import _jobs, task_maker, run_unit
+    from align.cli.batch import _jobs, run_unit, task_maker
     from align.production import read_manifest
 
     lot, _ = small_lot

@@ -92,7 +92,7 @@ def test_options_are_checked_against_the_command_when_the_manifest_is_read(lot3,
 
 
 def test_axis_down_files_resolve_against_the_manifest_and_enter_the_hash(tmp_path, monkeypatch):
-    from align.cli.batch import _jobs, task_maker, check_options
+    from align.cli.batch import _jobs, check_options, task_maker
 
     data = tmp_path / "data"
     data.mkdir()
@@ -137,7 +137,7 @@ def test_a_foreign_parquet_and_a_bad_scheduler_are_one_line(lot3, tmp_path, run_
 def test_old_spellings_of_options_are_taken_as_the_command_takes_them(tmp_path):
     """``calibrate ferraris --acc-units`` (today --accel-units) in a manifest: the unit's options are the single
     command's."""
-    from align.cli.batch import _jobs, task_maker, check_options
+    from align.cli.batch import _jobs, check_options, task_maker
     from align.cli.options import ALIASES
 
     old, new = next(iter(ALIASES["calibrate ferraris"].items()))

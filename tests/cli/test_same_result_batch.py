@@ -153,7 +153,7 @@ def test_every_batch_job_runs_its_library_job(units):
     """No command line inside the worker: every job of a batch has its options builder, and a unit's task holds
     the job's options, built from its row in this process."""
     import align.api as ia
-    from align.cli.batchjobs import JOBS, _jobs, task_maker, check_options
+    from align.cli.batchjobs import JOBS, _jobs, check_options, task_maker
     from align.cli.builders import BUILDERS
     from align.production import Task, Unit
 

@@ -3,6 +3,7 @@ manifest, in every row of the lot's store; a test time without its zone, or not 
 
 from __future__ import annotations
 
+import math
 from datetime import UTC, datetime, timedelta, timezone
 
 import pytest
@@ -71,8 +72,14 @@ def test_the_trend_over_time_follows_the_test_time_not_when_the_rows_were_made(t
     rows = [{"serial": f"U{k}", "job": "matrix", "order": 0, "time": run + timedelta(minutes=39 - k),
              "test_time": t0 + timedelta(hours=6 * k), "status": "ok", "sensor": "gyroscope", "message": "",
              "scale_x": 1.0 + 1e-4 * (k / 4)} for k in range(40)]
-    (fs,) = lot_statistics(rows, read_spec(tmp_path / "s.toml"), "time").figures
-    assert fs.slope == pytest.approx(1e-4) and fs.x[-1] == pytest.approx(39 / 4)
+    got = lot_statistics(rows, read_spec(tmp_path / "s.toml"), "time")
+    (fs,) = got.figures
+    assert fs.slope == pytest.approx(1e-4) and fs.x[-1] == pytest.approx(39 / 4) and not got.notes
+    same = [{**r, "test_time": t0} for r in rows]  # every unit tested at one time: no trend, and said why
+    got = lot_statistics(same, read_spec(tmp_path / "s.toml"), "time")
+    assert math.isnan(got.figures[0].slope)
+    assert got.notes == ("no trend over time: every unit has the same test time (the manifest's test_time, or the "
+                         "log's, else when its row was made); give each unit its own, or trend over the lot's order",)
 
 
 # ---- identity from the log (issue 27: "test time from the log where it has one") ----
