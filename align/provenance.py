@@ -164,11 +164,16 @@ def start_hashing(paths: list[str | Path]) -> None:
     threading.Thread(target=work, name="imu-align-sha256", daemon=True).start()
 
 
-def prehashed_record(role: str, path: str | Path) -> InputFile:
-    """The file's record: the one computed in the background when the file is unchanged, else computed now."""
+def prehashed_record(role: str, path: str | Path, keep: bool = False) -> InputFile:
+    """The file's record: the one computed in the background when the file is unchanged, else computed now.
+
+    ``keep``: the background's record stays for the result's provenance to take (a job that checks a digest while
+    it reads, :func:`align.alignment.jobs.verify_job.read_verify`, waits for the same hash instead of computing it
+    a second time).
+    """
     key = _key(path)
     with _LOCK:
-        future = _PENDING.pop(key, None) if key is not None else None
+        future = (_PENDING.get(key) if keep else _PENDING.pop(key, None)) if key is not None else None
     if future is not None and future.exception() is None:
         done = future.result()
         if done.size >= 0 and _key(path) == key:

@@ -31,7 +31,7 @@ from align.errors import InputError, literal
 from align.io.source import LogSource
 from align.job import Job, Progress, fields_signature, quantity
 from align.keyfigures import AXES, figures_from, matrix_figures
-from align.provenance import file_record
+from align.provenance import prehashed_record
 from align.results import Result
 from align.units import DEG
 
@@ -155,7 +155,7 @@ def read_verify(options: VerifyOptions) -> VerifyInputs:
                          "session (give its gyroscope with {sensor})", where)
     session = read_matrix(options.matrix_options())
     fitted = {f.sha256 for f in getattr(result.provenance, "files", ()) if f.role == "log" and f.sha256}
-    if fitted and file_record("log", options.log.path).sha256 in fitted:
+    if fitted and prehashed_record("log", options.log.path, keep=True).sha256 in fitted:
         raise InputError(f"is the session {literal(where)} was fitted on (the same bytes as its provenance's log): its "
                          "residual says nothing of other sessions; verify on another session of the unit",
                          str(options.log.path))
