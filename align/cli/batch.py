@@ -30,6 +30,7 @@ from align.cli.batchjobs import (  # noqa: F401
     check_options,
     parse_rows,
     task_maker,
+    validation_unit,
 )
 
 # ---- the worker: the unit's library job ----
@@ -65,7 +66,8 @@ Scheduler = Annotated[str | None, typer.Option("--scheduler", metavar="ADDRESS",
 
 def batch(
     manifest: opt.Arg("Manifest: CSV with columns serial, job, log, plan, options and optionally slot, station, "
-                      "fixture, operator, device_id, test_time (ISO 8601 with its zone), or TOML "
+                      "fixture, operator, device_id, test_time (ISO 8601 with its zone), validation, validation_plan, "
+                      "validation_options (a rate-table session the unit's result is replayed on by verify), or TOML "
                       "([[unit]] tables, [defaults]); paths relative to it. Jobs: matrix (plan: its --plan), "
                       "calibrate ferraris (--sections), calibrate accel (--positions), calibrate mag, calibrate gyro, "
                       "allan; options as the single command takes them.", "MANIFEST"),
@@ -94,7 +96,7 @@ def batch(
     from align.errors import CheckFailed, InputError, TestError
     from align.present.lot import batch_summary
     from align.production import TABLE, BatchRun, judge_rows, make_pool, plan_tasks, read_manifest, read_spec, run_units
-    from align.production.batch import locked
+    from align.production.lock import locked
     from align.production.stats import figures_needed, rejudge_rows
     from align.production.table import now
 
@@ -105,6 +107,8 @@ def batch(
     lot = read_manifest(manifest, jobs)
     for unit in lot:
         check_options(unit, str(manifest))
+        if unit.validation is not None:
+            check_options(validation_unit(unit), str(manifest))
     pool = make_pool(workers or os.cpu_count() or 1, scheduler, _preload(lot.jobs))
     pool.prestart()  # a fork server's workers start (and import the jobs) while the rows are parsed here
     try:

@@ -16,7 +16,8 @@ every other input the options name, the ``--axis-down`` captures included).
 
 Public names
 ------------
-JOBS, RESERVED, OUTPUT_OPTIONS, Prepared, check_options, prepare_unit, parse_rows, task_maker, error_line
+JOBS, RESERVED, OUTPUT_OPTIONS, Prepared, check_options, prepare_unit, prepare_validation, validation_unit, parse_rows,
+task_maker, error_line
 """
 
 from __future__ import annotations
@@ -45,6 +46,24 @@ RESERVED = ("--json", "--help", "--version")
 OUTPUT_OPTIONS = ("--c-header", "--plot", "--imucal-json", "--json")
 #: str options whose value names input files, with how to find them: option -> parser of the value
 FILE_LISTS = ("--axis-down",)
+
+
+def _plan_flag(job: str) -> str | None:
+    """The option a unit's plan is given as: its job's (:data:`JOBS`), ``--plan`` for a validation run's ``verify``."""
+    return "--plan" if job == "verify" else JOBS[job][0]
+
+
+def validation_unit(unit):
+    """A unit's validation run as a unit of job ``verify``: the validation session as its log, its plan and
+    ``verify``'s options (the row's ``validation*`` columns), for :func:`check_options` and :func:`prepare_unit`."""
+    from dataclasses import replace
+
+    return replace(unit, job="verify", log=unit.validation, plan=unit.validation_plan,
+                   options=unit.validation_options, validation=None, validation_plan=None, validation_options=())
+
+
+def _column(unit) -> str:
+    return "validation_options" if unit.job == "verify" else "options"
 
 
 def _jobs() -> dict[str, str]:
@@ -79,13 +98,13 @@ def check_options(unit, where: str) -> None:
     from align.cli.options import ALIASES
 
     def bad(what: str) -> InputError:
-        return InputError(f"{unit.row}, column options: {what}", where)
+        return InputError(f"{unit.row}, column {_column(unit)}: {what}", where)
 
     aliases = ALIASES.get(unit.job, {})
     params = [p for p in _click(unit.job).params if getattr(p, "param_type_name", "") == "option"]
     flags = {o for p in params if getattr(p, "is_flag", False) for o in (*p.opts, *p.secondary_opts)}
     names = {o for p in params for o in (*p.opts, *p.secondary_opts)}
-    plan_flag = JOBS[unit.job][0]
+    plan_flag = _plan_flag(unit.job)
     words, i = unit.options, 0
     while i < len(words):
         word = words[i]
@@ -238,26 +257,27 @@ def _hashed(unit, files) -> tuple[Path | None, ...]:
     return (*first, *rest)
 
 
-def _parsed(unit, folder: Path, where: str, cache: dict | None) -> dict[str, Any]:
+def _parsed(unit, folder: Path, where: str, cache: dict | None, first: tuple[Path, ...] = ()) -> dict[str, Any]:
     """The command's parameters for the unit's row, as click parses them, paths resolved against ``folder``.
 
     Rows of one job with the same options words differ only in their log and plan: those are parsed and resolved
     once (``cache``), the row's log and plan (resolved by the manifest's reader) put in place for each row (a
-    path's value is not checked when parsed).
+    path's value is not checked when parsed). ``first``: arguments before the log (a validation run's ``verify``
+    takes the result it replays first).
     """
     from align.cli import _usage_message
     from align.cli.options import rewrite_aliases
 
     command = _click(unit.job)
-    flag = JOBS[unit.job][0]
-    log_name = next(p.name for p in command.params if getattr(p, "param_type_name", "") == "argument")
+    flag = _plan_flag(unit.job)
+    names = [p.name for p in command.params if getattr(p, "param_type_name", "") == "argument"]
     plan_name = next((p.name for p in command.params if flag in getattr(p, "opts", ())), None) if flag else None
     key = (unit.job, unit.options, unit.plan is None, folder)
     if cache is not None and key in cache:
         params = dict(cache[key])
     else:
         words = _resolved(unit.options, folder)  # --axis-down's files made absolute
-        args = [str(unit.log), *([str(flag), str(unit.plan)] if unit.plan is not None else []),
+        args = [*map(str, first), str(unit.log), *([str(flag), str(unit.plan)] if unit.plan is not None else []),
                 *rewrite_aliases(unit.job, words)]
         try:
             params = dict(command.make_context(f"imu-align {unit.job}", args, resilient_parsing=False).params)
@@ -265,12 +285,12 @@ def _parsed(unit, folder: Path, where: str, cache: dict | None) -> dict[str, Any
             if not (hasattr(exc, "exit_code") and hasattr(exc, "format_message")):  # no usage error (click's, typer's)
                 raise
             what = " ".join(_usage_message(exc, unit.job.split(), args).split())
-            raise InputError(f"{unit.row}, column options: {what}", where) from None
+            raise InputError(f"{unit.row}, column {_column(unit)}: {what}", where) from None
         paths = _path_params(unit.job)
         params = {name: _absolute(value, folder, name in paths) for name, value in params.items()}
         if cache is not None:
             cache[key] = dict(params)
-    params[log_name] = unit.log
+    params.update(zip(names, (*first, unit.log)))
     if plan_name is not None:
         params[plan_name] = unit.plan
     return params
@@ -317,12 +337,32 @@ def prepare_unit(unit, folder: Path, where: str, cache: dict | None = None) -> P
 
 
 def parse_rows(units, folder: Path, where: str) -> dict:
-    """Every unit's row parsed by its job's command, rows with the same options words once: a row the command
-    refuses is refused before any unit runs. The parse cache :func:`task_maker` builds each unit's options from."""
+    """Every unit's row parsed by its job's command (and its validation run's by ``verify``), rows with the same
+    options words once: a row the command refuses is refused before any unit runs. The parse cache
+    :func:`task_maker` builds each unit's options from."""
     cache: dict = {}
     for u in units:
         _parsed(u, folder, where, cache)
+        if u.validation is not None:
+            _parsed(validation_unit(u), folder, where, cache, (Path("result.json"),))
     return cache
+
+
+def prepare_validation(unit, result: Path, folder: Path, where: str, cache: dict | None = None
+                       ) -> tuple[Any, tuple[int, str] | None, tuple[Path, ...]]:
+    """``verify``'s options for a unit's validation run (its ``result`` replayed on the validation session), the
+    refusal of a library error while they are built, and the files the content hash covers beside the unit's."""
+    from align.api import job as find
+    from align.cli.builders import options_builder
+
+    check = validation_unit(unit)
+    params = _parsed(check, folder, where, cache, (result,))
+    try:
+        options = options_builder("verify")(**params)
+        files = [p for k, p in find("verify").files(options).items() if k != "result" and p is not None]
+    except AlignError as exc:
+        return None, error_line("verify", exc), (check.log, check.plan)
+    return options, None, tuple(Path(p) for p in files)
 
 
 def task_maker(folder: Path, cache: dict | None = None, where: str | None = None):
@@ -333,7 +373,12 @@ def task_maker(folder: Path, cache: dict | None = None, where: str | None = None
     cache = {} if cache is None else cache
 
     def make(unit, result: Path, run: str) -> Task:
-        got = prepare_unit(unit, folder, where or str(folder), cache)
-        return Task(unit, result.resolve(), got.inputs, run, got.options, got.params, got.refused)
+        said = where or str(folder)
+        got, result = prepare_unit(unit, folder, said, cache), result.resolve()
+        if unit.validation is None:
+            return Task(unit, result, got.inputs, run, got.options, got.params, got.refused)
+        check, refused, files = prepare_validation(unit, result, folder, said, cache)
+        inputs = (*got.inputs, *(f for f in files if f not in got.inputs))
+        return Task(unit, result, inputs, run, got.options, got.params, got.refused, check, refused)
 
     return make

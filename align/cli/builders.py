@@ -29,6 +29,7 @@ BUILDERS: dict[str, tuple[str, str | None]] = {
     "plan": ("align.cli.plan:plan_options", None),
     "matrix": ("align.cli.matrix:matrix_options", "align.cli.matrix:matrix_files"),
     "apply": ("align.cli.apply:apply_options", "align.cli.apply:apply_files"),
+    "verify": ("align.cli.verify:verify_options", None),
     "calibrate ferraris": ("align.cli.calibrate_ferraris:ferraris_options",
                            "align.cli.calibrate_ferraris:ferraris_files"),
     "calibrate accel": ("align.cli.calibrate_accel:accel_options", "align.cli.calibrate_accel:accel_files"),

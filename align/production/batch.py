@@ -5,19 +5,21 @@ manifest row by the command's own parser and options builder; its result file; i
 worker through a pool (:mod:`align.production.pools`). The worker (:func:`run_job`) calls the library
 job (``align.api.job(name).run(options)``), writes the JSON result and the extra files the unit's output
 options ask for (all or none, :class:`align.io.outputs.Outputs`) and returns the table rows made from the
-result in memory (:func:`align.production.keyfigures.result_rows`). The rows are appended to the lot's table
-through a journal (:class:`align.production.table.Journal`): per unit as it finishes, so that a killed
-batch keeps what was done.
+result in memory (:func:`align.production.keyfigures.result_rows`); a unit with a validation run then replays
+its result on the validation session (``verify``: rows of job ``verify JOB``, result ``SERIAL.JOB.verify.json``).
+The rows are appended to the lot's table through a journal (:class:`align.production.table.Journal`): per unit as
+it finishes, so that a killed batch keeps what was done.
 
-Resuming: a unit is skipped when its result file exists and the table's latest row for it (serial
+Resuming: a unit is skipped when its result files exist and the table's latest row for it (serial
 and job) succeeded with the same content hash of its inputs (:func:`align.production.manifest.input_hash`:
-the imu-align version, job, options, the bytes of its log, plan and input files); ``rerun`` skips none.
+the imu-align version, job, options, the bytes of its log, plan and input files, and its validation run's);
+``rerun`` skips none.
 Any other unit runs again; its old result file is removed first, so that a unit that fails now leaves no
 result of other inputs behind.
 
 Public names
 ------------
-Task, plan_tasks, run_units, run_job, unit_rows, result_unit_rows, error_rows, locked, TABLE, UNITS (and BatchRun, from
+Task, plan_tasks, run_units, run_job, unit_rows, result_unit_rows, error_rows, TABLE, UNITS (and BatchRun, from
 :mod:`align.production.batchrun`)
 """
 
@@ -27,12 +29,11 @@ import os
 import socket
 import time
 from collections.abc import Callable, Iterable, Iterator, Mapping
-from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from align.errors import AlignError, InputError
+from align.errors import AlignError
 from align.production.batchrun import BatchRun
 from align.production.identity import log_identity, unit_identity
 from align.production.keyfigures import result_rows
@@ -67,6 +68,11 @@ class Task:
         a C header): what the job's files builder takes; empty when only the JSON result is written.
     refused : (int, str), optional
         The exit status and one-line message of a unit whose options the job refused before it ran.
+    validation : object, optional
+        ``verify``'s options for the unit's validation run (:attr:`Unit.validation`): its result replayed on the
+        validation session; None when the unit has none, or when they were refused (``validation_refused``).
+    validation_refused : (int, str), optional
+        The exit status and one-line message of ``verify``'s refusal of the validation run's options.
     """
 
     unit: Unit
@@ -76,11 +82,26 @@ class Task:
     options: Any = None
     params: Mapping[str, Any] = field(default_factory=dict)
     refused: tuple[int, str] | None = None
+    validation: Any = None
+    validation_refused: tuple[int, str] | None = None
+
+    @property
+    def validation_result(self) -> Path:
+        """The validation run's result file, ``OUT/units/SERIAL.JOB.verify.json``."""
+        return self.result.with_name(self.result.name.removesuffix(".json") + ".verify.json")
+
+    @property
+    def outputs(self) -> tuple[Path, ...]:
+        """The result files a unit done leaves: its result, and its validation run's."""
+        return (self.result, self.validation_result) if self.unit.validation is not None else (self.result,)
 
     def digest(self, known: Mapping[str, str] | None = None) -> str:
         """The content hash of the unit's inputs now (``known``: path -> SHA-256 of files hashed already, see
-        :func:`align.production.manifest.input_hash`)."""
-        return input_hash(self.unit.job, self.unit.options, self.inputs, known)
+        :func:`align.production.manifest.input_hash`); a validation run's options enter after a separator."""
+        words = self.unit.options
+        if self.unit.validation is not None:
+            words = (*words, "\0validation", *self.unit.validation_options)
+        return input_hash(self.unit.job, words, self.inputs, known)
 
 
 def _base(task: Task) -> dict:
@@ -146,43 +167,71 @@ def run_job(task: Task, files: Callable | None = None,
     Returns
     -------
     list of dict
-        The unit's rows: one per sensor, or one ``"failed"`` / ``"error"`` row with the one-line message.
+        The unit's rows: one per sensor, or one ``"failed"`` / ``"error"`` row with the one-line message; then, for
+        a unit with a validation run (:attr:`Task.validation`), that run's rows (job ``verify JOB``).
     """
-    import warnings
-
-    from align.api import job as find
-    from align.io.outputs import Outputs
-
     say = say or _say
     started = time.perf_counter()
     if task.refused is not None:
         return unit_rows(task, *task.refused, task.digest(), 0.0)
     try:
-        with warnings.catch_warnings():  # as the command line: a result that cannot be trusted is refused instead
-            warnings.simplefilter("ignore")
-            job = find(task.unit.job)
-            if task.params and files is not None:  # extra files: the job's checked inputs are drawn too
-                result, inputs = job.run_with_inputs(task.options)
-                extra = files(result, inputs, task.params)
-            else:
-                result, extra = job.run(task.options), []
-            ident, _ = unit_identity(dict(task.unit.identity), log_identity(result))
-            result = result.replace(provenance=replace(result.provenance, unit={"serial": task.unit.serial, **ident}))
-            with Outputs() as out:  # all or none
-                out.write_json(task.result, result)
-                for path, data in extra:
-                    if isinstance(data, bytes):
-                        out.write_bytes(path, data)
-                    else:
-                        out.write_text(path, data)
+        result = _run(task.unit.job, task.options, task.result, task.unit, files if task.params else None, task.params)
     except Exception as exc:  # the job refused the unit (its exit status), or failed inside (status 1)
         code, message = say(task.unit.job, exc)
         return unit_rows(task, code if code != 0 else 1, message, task.digest(), time.perf_counter() - started)
     finally:
         release_memory()  # a worker runs thousands of units: its heap's free pages go back after each
     # the content hash from the bytes the job's provenance hashed (read once), the other inputs read now
-    read = {f.path: f.sha256 for f in getattr(result.provenance, "files", ())}
-    return result_unit_rows(task, result, "", task.digest(read), time.perf_counter() - started)
+    digest = task.digest({f.path: f.sha256 for f in getattr(result.provenance, "files", ())})
+    rows = result_unit_rows(task, result, "", digest, time.perf_counter() - started)
+    return rows if task.unit.validation is None else rows + _validated(task, say, digest)
+
+
+def _run(name: str, options: Any, path: Path, unit: Unit, files: Callable | None = None,
+         params: Mapping[str, Any] | None = None):
+    """Run job ``name`` on ``options`` as the command line does (a warning is no reason to stop: a result that
+    cannot be trusted is refused instead), stamp the unit's identity in its provenance, and write its JSON at
+    ``path`` with the extra files ``files(result, inputs, params)`` gives, all or none."""
+    import warnings
+
+    from align.api import job as find
+    from align.io.outputs import Outputs
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        job = find(name)
+        if params and files is not None:  # extra files: the job's checked inputs are drawn too
+            result, inputs = job.run_with_inputs(options)
+            extra = files(result, inputs, params)
+        else:
+            result, extra = job.run(options), []
+        ident, _ = unit_identity(dict(unit.identity), log_identity(result))
+        result = result.replace(provenance=replace(result.provenance, unit={"serial": unit.serial, **ident}))
+        with Outputs() as out:  # all or none
+            out.write_json(path, result)
+            for where, data in extra:
+                if isinstance(data, bytes):
+                    out.write_bytes(where, data)
+                else:
+                    out.write_text(where, data)
+    return result
+
+
+def _validated(task: Task, say: Callable[[str, BaseException], tuple[int, str]], digest: str) -> list[dict]:
+    """The rows of a unit's validation run (job ``verify JOB``): its result replayed on the validation session by
+    ``verify`` (:mod:`align.alignment.jobs.verify_job`), the residual's figures and verdict; a refusal's one row."""
+    started = time.perf_counter()
+    mine = replace(task, unit=replace(task.unit, job=f"verify {task.unit.job}"), result=task.validation_result)
+    if task.validation_refused is not None:
+        return error_rows(mine, "failed", *task.validation_refused, digest, 0.0)
+    try:
+        result = _run("verify", task.validation, mine.result, task.unit)
+    except Exception as exc:
+        code, message = say("verify", exc)
+        return unit_rows(mine, code if code != 0 else 1, message, digest, time.perf_counter() - started)
+    finally:
+        release_memory()
+    return result_unit_rows(mine, result, "", digest, time.perf_counter() - started)
 
 
 def plan_tasks(units: Iterable[Unit], out: Path, make: Callable[[Unit, Path, str], Task],
@@ -235,14 +284,15 @@ def plan_tasks(units: Iterable[Unit], out: Path, make: Callable[[Unit, Path, str
 def _sorted(batch: list[tuple[Unit, Task]], last: LatestRuns, rerun: bool,
             skip: Callable[[list[dict]], None] | None) -> Iterator[Task]:
     """The tasks of ``batch`` to run; the latest rows of the units skipped to ``skip``."""
-    done = [] if rerun else [task for unit, task in batch if task.result.exists()
+    done = [] if rerun else [task for unit, task in batch if all(p.exists() for p in task.outputs)
                              and last.status(unit.serial, unit.job) == "ok"]
     digests = _digests(done)
     skipped: list[tuple[Unit, list[int]]] = []
     for unit, task in batch:
         hashed = digests.get(id(task))
         if hashed is not None and last.input_hash(unit.serial, unit.job) == hashed:
-            skipped.append((unit, last.at[(unit.serial, unit.job)]))
+            checked = last.at.get((unit.serial, f"verify {unit.job}"), []) if unit.validation is not None else []
+            skipped.append((unit, last.at[(unit.serial, unit.job)] + checked))
             continue
         yield task
     if skip is not None and skipped:  # the skipped units' rows taken from the store at once
@@ -309,7 +359,8 @@ def run_units(tasks: Iterable[Task], worker: Callable[[Task], list[dict]], pool,
                 if task is None:
                     more = False
                     break
-                task.result.unlink(missing_ok=True)  # a result of other inputs, or of a run killed before its row
+                for path in task.outputs:  # a result of other inputs, or of a run killed before its row
+                    path.unlink(missing_ok=True)
                 flight[pool.submit(worker, task)] = (task, time.perf_counter())
             for fut in pool.wait(flight) if flight else ():
                 task, started = flight.pop(fut)
@@ -337,38 +388,3 @@ def _collect(fut, task: Task, started: float, pool) -> list[dict]:
     except Exception as exc:  # the worker's own failure (not the job's: the job's errors are its exit status)
         what = f"the worker failed ({' '.join(f'{type(exc).__name__}: {exc}'.split())[:240]})"
     return error_rows(task, "error", 1, f"imu-align: internal error: {what}", None, time.perf_counter() - started)
-
-
-@contextmanager
-def locked(out: Path) -> Iterator[None]:
-    """Hold the output folder for one batch at a time (``OUT/.batch.lock``, naming the host and process);
-    a lock whose process is gone (a killed batch on this host) is taken over."""
-    path = out / ".batch.lock"
-    me = f"{socket.gethostname()} {os.getpid()}"
-    for _ in range(2):
-        try:
-            fd = os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
-        except FileExistsError:
-            host, _, pid = (path.read_text(errors="replace").strip() or " ").partition(" ")
-            if not host or (host == socket.gethostname() and not _alive(pid)):  # empty: killed while writing it
-                path.unlink(missing_ok=True)
-                continue
-            raise InputError(f"another batch ({host}, process {pid}) is writing to {out}; wait for it, or give "
-                             f"another {{out}} (remove {path} if no batch runs)", "{out}") from None
-        with os.fdopen(fd, "w") as fh:
-            fh.write(me)
-        break
-    try:
-        yield
-    finally:
-        path.unlink(missing_ok=True)
-
-
-def _alive(pid: str) -> bool:
-    try:
-        os.kill(int(pid), 0)
-    except (ValueError, ProcessLookupError):
-        return False
-    except PermissionError:  # a process of another user
-        return True
-    return True

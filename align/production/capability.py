@@ -67,14 +67,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from align.production.normality import MIN_N_TEST, anderson_darling
+
 #: significance level of the normality test: the normal Cpk is shown when normality is not rejected at it
 ALPHA = 0.05
 #: bootstrap resamples of the percentile Cpk's interval
 BOOTSTRAP = 1000
 #: the fewest units for the percentile Cpk (its top sample quantile, 98.6 %, is then about the second-largest unit)
 MIN_N = 30
-#: the fewest units for the normality test
-MIN_N_TEST = 8
 #: a tail's fit: quantiles at normal scores ``z0 + STEP (-3, -1, 1, 3)`` (mirrored for the lower tail), ``z0`` from
 #: :func:`tail_centre` (``Z0`` up to 200 units)
 Z0, STEP = 1.0, 0.4
@@ -303,39 +303,6 @@ def percentile_cpk(quantiles: np.ndarray, low: float | None, high: float | None)
     up = (high - med) / (hi - med) if high is not None else np.full_like(med, np.inf)
     down = (med - low) / (med - lo) if low is not None else np.full_like(med, np.inf)
     return np.minimum(up, down)
-
-
-def anderson_darling(values: np.ndarray) -> tuple[float, float]:
-    """``(A^2, p)``: the Anderson-Darling statistic of normality (mean and ``ddof = 1`` deviation estimated) and
-    its p-value from ``A*^2 = A^2 (1 + 0.75/n + 2.25/n^2)`` (D'Agostino and Stephens 1986, Table 4.9); NaN for
-    fewer than :data:`MIN_N_TEST` values or none spread.
-
-    Examples
-    --------
-    >>> a2, p = anderson_darling(np.array([-1.5, -0.9, -0.4, -0.1, 0.2, 0.5, 1.0, 1.6]))
-    >>> round(a2, 3), p > 0.5
-    (0.096, True)
-    """
-    from scipy.special import log_ndtr
-
-    x = np.sort(np.asarray(values, float))
-    n = len(x)
-    s = float(np.std(x, ddof=1)) if n > 1 else 0.0
-    if n < MIN_N_TEST or not s > 0:
-        return math.nan, math.nan
-    z = (x - x.mean()) / s
-    i = np.arange(1, n + 1)
-    a2 = float(-n - np.sum((2 * i - 1) * (log_ndtr(z) + log_ndtr(-z[::-1]))) / n)
-    a = a2 * (1 + 0.75 / n + 2.25 / n ** 2)
-    if a >= 0.6:
-        p = math.exp(1.2937 - 5.709 * a + 0.0186 * a * a)
-    elif a >= 0.34:
-        p = math.exp(0.9177 - 4.279 * a - 1.38 * a * a)
-    elif a >= 0.2:
-        p = 1 - math.exp(-8.318 + 42.796 * a - 59.938 * a * a)
-    else:
-        p = 1 - math.exp(-13.436 + 101.14 * a - 223.73 * a * a)
-    return a2, min(1.0, max(0.0, p))
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,10 @@ becomes the unit's serial), and optionally ``slot`` (the fixture slot) and the u
 ``fixture``, ``operator``, ``device_id`` (the sensor's own id, as its log or label states it) and ``test_time``
 (when it was tested, ISO 8601 with its zone: ``2026-11-28T14:05:00+01:00`` or ``...Z``; a trend over test time
 needs it, the table's ``time`` being when the row was made; where not given, a log that states them gives
-``device_id`` and ``test_time``, :mod:`align.production.identity`). Paths are relative to the
+``device_id`` and ``test_time``, :mod:`align.production.identity`). A unit whose job gives a gyro correction
+(:data:`VALIDATED`) may name a validation run, a rate-table session its result was not fitted to, replayed on it by
+``imu-align verify`` once the job is done: ``validation`` (its log), ``validation_plan`` (its plan; a ``matrix``
+unit's own plan when empty) and ``validation_options`` (``verify``'s options). Paths are relative to the
 manifest's folder. A bad manifest is one :class:`~align.errors.InputError` naming the file, the
 row (CSV line or ``[[unit]]`` number) and the column.
 
@@ -22,7 +25,7 @@ The content hash of a unit's inputs (:func:`input_hash`) decides whether a rerun
 
 Public names
 ------------
-Unit, Manifest, read_manifest, input_hash, PLAN_USE, SERIAL, IDENTITY
+Unit, Manifest, read_manifest, input_hash, PLAN_USE, SERIAL, IDENTITY, VALIDATED
 """
 
 from __future__ import annotations
@@ -47,7 +50,10 @@ PLAN_USE = ("required", "optional", "none")
 SERIAL = re.compile(r"^[A-Za-z0-9_-][A-Za-z0-9._-]{0,127}$")
 #: the columns of a manifest: required ones, then optional ones
 REQUIRED = ("serial", "job", "log")
-OPTIONAL = ("plan", "options", "slot", "station", "fixture", "operator", "device_id", "test_time")
+OPTIONAL = ("plan", "options", "slot", "station", "fixture", "operator", "device_id", "test_time", "validation",
+            "validation_plan", "validation_options")
+#: the jobs whose result a validation run replays (``imu-align verify``: a gyro correction on a rate-table session)
+VALIDATED = ("matrix", "calibrate ferraris", "calibrate gyro")
 #: the optional columns that identify how the unit was tested (carried into its rows of the lot's table)
 IDENTITY = ("station", "fixture", "operator", "device_id", "test_time")
 
@@ -77,6 +83,12 @@ class Unit:
         Where the unit is stated, for messages: ``"line 4"`` (CSV) or ``"[[unit]] 3"`` (TOML).
     identity : tuple of (str, str)
         The identity columns given (:data:`IDENTITY`), ``test_time`` as ISO 8601 with its zone.
+    validation : Path or None
+        A rate-table session the unit's result is replayed on (``imu-align verify``), absolute; None: none.
+    validation_plan : Path or None
+        That session's plan (a ``matrix`` unit's own plan when not given).
+    validation_options : tuple of str
+        ``verify``'s options for it, split as typed (``--gyro-units deg/s``, ``--tolerance-angle "0.05 deg"``).
     """
 
     serial: str
@@ -88,6 +100,9 @@ class Unit:
     order: int
     row: str
     identity: tuple[tuple[str, str], ...] = ()
+    validation: Path | None = None
+    validation_plan: Path | None = None
+    validation_options: tuple[str, ...] = ()
 
     @property
     def result_name(self) -> str:
@@ -245,7 +260,8 @@ def _toml_records(path: Path) -> list[tuple[str, dict]]:
 
 def _checked(record: dict, row: str, jobs: Mapping[str, str], where: str) -> tuple:
     """A row checked, as the words a :class:`Unit` is made of: ``(row, serial, job, log, plan, options, slot,
-    identity)`` (``log`` and ``plan`` as written, relative to the manifest; ``plan`` ``""`` when not given)."""
+    identity, validation, validation_plan, validation_options)`` (paths as written, relative to the manifest;
+    ``""`` when not given)."""
     def bad(column: str, what: str) -> InputError:
         return InputError(f"{row}, column {column}: {what}", where)
 
@@ -267,21 +283,40 @@ def _checked(record: dict, row: str, jobs: Mapping[str, str], where: str) -> tup
         raise bad("plan", f"empty; the {job} job needs one")
     if use == "none" and plan:
         raise bad("plan", f"the {job} job takes no plan; leave it empty")
+    options, checks = _words(record, "options", serial, bad), _words(record, "validation_options", serial, bad)
+    check = record.get("validation", "")
+    check_plan = record.get("validation_plan", "") or (plan if check and job == "matrix" else "")
+    if not check and (check_plan or checks):
+        raise bad("validation", "empty, while validation_plan or validation_options is given; give the validation "
+                  "session's log")
+    if check and job not in VALIDATED:
+        raise bad("validation", f"the {job} job's result is no gyro correction a rate-table session could replay; "
+                  f"validation goes with {', '.join(VALIDATED)}")
+    if check and not check_plan:
+        raise bad("validation_plan", f"empty; give the validation session's test plan (a {job} unit has no plan of "
+                  "a rate-table session)")
+    return (row, serial, job, log, plan, options, record.get("slot") or None, _identity(record, bad), check,
+            check_plan, checks)
+
+
+def _words(record: dict, column: str, serial: str, bad) -> tuple[str, ...]:
+    """A column of options, split as a POSIX shell splits them, ``{serial}`` replaced."""
     try:
-        options = tuple(t.replace("{serial}", serial) for t in shlex.split(record.get("options", ""), comments=False))
+        return tuple(t.replace("{serial}", serial) for t in shlex.split(record.get(column, ""), comments=False))
     except ValueError as exc:
-        raise bad("options", f"cannot be split ({exc}); check the quotes") from None
-    return row, serial, job, log, plan, options, record.get("slot") or None, _identity(record, bad)
+        raise bad(column, f"cannot be split ({exc}); check the quotes") from None
 
 
 def _make(order: int, row: tuple, folder: Path, plans: dict[str, Path]) -> Unit:
     """The :class:`Unit` of a checked row (:func:`_checked`), its paths resolved against ``folder`` (the plans,
     often one for the whole lot, resolved once: ``plans``)."""
-    where, serial, job, log, plan, options, slot, identity = row
-    if plan and plan not in plans:
-        plans[plan] = (folder / plan).resolve()
+    where, serial, job, log, plan, options, slot, identity, check, check_plan, checks = row
+    for p in (plan, check_plan):
+        if p and p not in plans:
+            plans[p] = (folder / p).resolve()
     return Unit(serial, job, (folder / log).resolve(), plans[plan] if plan else None, options, slot, order, where,
-                identity)
+                identity, (folder / check).resolve() if check else None, plans[check_plan] if check_plan else None,
+                checks)
 
 
 def _identity(record: dict, bad) -> tuple[tuple[str, str], ...]:
