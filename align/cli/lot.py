@@ -26,7 +26,7 @@ def lot(
 ) -> None:
     """Statistics of a lot (each unit's latest run): count, mean, spread, Cpk, yield, outliers, trend.
 
-    Exit status 4 when a unit failed, gave an error or is outside the spec (listed first).
+    Exit status 4 when a unit failed, gave an error or is outside the spec (listed under "units not passing").
     """
     from align.cli.paths import check_outputs, outputs
 
@@ -60,7 +60,7 @@ def lot(
         typer.echo("\nunits grouped by thermal profile:\n" + "\n".join(f"  {c}" for c in thermal_lines(thermal)))
     bad = stats.count - stats.passed
     if bad:
-        raise CheckFailed(f"{bad} of {stats.count} units do not pass (listed first)", str(table))
+        raise CheckFailed(f"{bad} of {stats.count} units do not pass (listed above)", str(table))
 
 
 COMMANDS = {"lot": lot}

@@ -215,8 +215,8 @@ def time_unit(step: float, column: str, where: str, given: str | None = None,
     fix = (f"the step suggests {{time_units={found}}}" if found is not None and found != given and not stated
            else "it is the log's own time (its unit stated): read another stream ({topic})" if stated
            else "check the time column ({columns}), or read the log without it ({rate_hz})")
-    raise InputError(f"{name} in {given}: its median step {step:.4g} {given} is {_rate(step, given):.3g} Hz, not an "
-                     f"IMU sample rate ({band}); {fix}", where)
+    raise InputError(f"{name} in {given}: its median step {step:.6g} {given} is {_rate(step, given):.6g} Hz, not an "
+                     f"IMU sample rate ({band}); {fix}", where)  # 6 digits: 0.99995 Hz is not shown as 1 Hz
 
 
 # ---- text sources for pyarrow's CSV reader ----

@@ -83,6 +83,10 @@ def batch_summary(run, manifest: str, where: str, table_path, seconds: float) ->
     if bad:
         lines.append(f"units not passing ({len(bad)}):")
         lines += [f"  {r['serial']:<12} {r['verdict']:<7} {r['message']}" for r in sorted(bad, key=lambda r: r['order'])]
+    said = [r for r in run.lot("ok", "warn") if r.get("message")]
+    if said:
+        lines.append(f"units passing with a warning ({len(said)}):")
+        lines += [f"  {r['serial']:<12} {r['message']}" for r in sorted(said, key=lambda r: r['order'])]
     return "\n".join(lines)
 
 
@@ -113,7 +117,8 @@ def capability_lines(stats) -> list[str]:
         if cap.used == "percentile":
             out.append(f"{_name(fs)}: {pct}; {cap.why}; {normal}: {cap.normal_note}")
         else:
-            out.append(f"{_name(fs)}: {normal}; {cap.why}" + (f"; {cap.normal_note}" if cap.normal_note else "")
+            said = cap.normal_note and "not normal" not in cap.why  # the reason once
+            out.append(f"{_name(fs)}: {normal}; {cap.why}" + (f"; {cap.normal_note}" if said else "")
                        + f"; {pct}")
     return out
 
@@ -176,7 +181,8 @@ def lot_summary(stats, source: str) -> str:
     """The lot's statistics as text: yield, a table of the figures, the units that do not pass, outliers, trends."""
     if not stats.count:
         return f"lot of {source}: no units"
-    spec = f", spec {stats.spec.path}" if stats.spec else " (no spec: no limits, Cpk or yield)"
+    spec = (f", spec {stats.spec.path}" if stats.spec else
+            " (no spec: no limits or Cpk; the yield counts the units whose jobs ran)")
     lo, hi = stats.yield_interval
     lines = [f"lot of {source}: {stats.count} units (serials; each job's latest run){spec}",
              f"yield {stats.passed} of {stats.count} = {100 * stats.yield_:.1f} % (95 % Wilson interval "

@@ -123,14 +123,17 @@ def result_unit_rows(task: Task, result, message: str, digest: str, seconds: flo
     """The rows of a unit whose job gave ``result`` (in memory): one per sensor with its figures
     (:func:`align.production.keyfigures.result_rows`), status ``"ok"``; the unit's identity completed from its
     log (:func:`align.production.identity.unit_identity`), a device id other than the manifest's said in the
-    message."""
+    message and a warning."""
     stamp = now()
     found = result_rows(result) if result is not None else []
     ident, said = unit_identity(dict(task.unit.identity), log_identity(result) if result is not None else {})
-    message = "; ".join(filter(None, [message, said]))
-    return [{**_base(task), **ident, "time": stamp, "status": "ok", "exit_code": 0, "message": message,
+    rows = [{**_base(task), **ident, "time": stamp, "status": "ok", "exit_code": 0, "message": message,
              "input_hash": digest, "seconds": seconds, **r}
             for r in (found or [{"sensor": None, "verdict": "pass", "checks": ""}])]
+    for r in rows if said else ():  # another device than the manifest's: a warning the batch's summary lists
+        r["message"] = "; ".join(filter(None, [r.get("message"), said]))
+        r["verdict"] = "warn" if r["verdict"] == "pass" else r["verdict"]
+    return rows
 
 
 def unit_rows(task: Task, exit_code: int, message: str, digest: str, seconds: float, result=None) -> list[dict]:
@@ -363,17 +366,34 @@ def run_units(tasks: Iterable[Task], worker: Callable[[Task], list[dict]], pool,
                     path.unlink(missing_ok=True)
                 flight[pool.submit(worker, task)] = (task, time.perf_counter())
             for fut in pool.wait(flight) if flight else ():
-                task, started = flight.pop(fut)
-                rows = _collect(fut, task, started, pool)
-                rows = judge(rows) if judge is not None else rows
-                journal.add(rows)
-                run.add(rows)
+                _keep(fut, flight.pop(fut), pool, judge, journal, run)
                 done += 1
                 if progress is not None:
                     progress(done)
+    except KeyboardInterrupt:  # the units queued are dropped; those running finish (workers ignore Ctrl-C) and are kept
+        running = {f for f in flight if not f.cancel() and not _cancelled(f)}
+        while running:
+            for fut in pool.wait(running):
+                running.discard(fut)
+                _keep(fut, flight.pop(fut), pool, judge, journal, run)
+        raise
     finally:
         journal.fold()
     return run
+
+
+def _keep(fut, held: tuple[Task, float], pool, judge, journal: Journal, run: BatchRun) -> None:
+    """A finished unit's rows judged, journaled and kept in ``run``."""
+    rows = _collect(fut, *held, pool)
+    rows = judge(rows) if judge is not None else rows
+    journal.add(rows)
+    run.add(rows)
+
+
+def _cancelled(fut) -> bool:
+    """Whether a future was cancelled (a Dask future's ``cancel`` returns nothing: its state says)."""
+    state = getattr(fut, "cancelled", None)
+    return bool(state()) if callable(state) else False
 
 
 def _collect(fut, task: Task, started: float, pool) -> list[dict]:

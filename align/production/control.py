@@ -60,9 +60,10 @@ class Signal:
     count: int = 0
 
     def describe(self) -> str:
-        """``rule 2 (2 of 3 points beyond 2 sigma on one side, above) at unit SN0061 (#61)``."""
+        """``rule 2 (2 of 3 points beyond 2 sigma on one side, above) at unit SN0061 (point 61 of the chart)``: the
+        point counted from 1, in the chart's order (units without the figure are not on it)."""
         side = f", {self.side}" if self.side else ""
-        return f"rule {self.rule} ({RULES[self.rule]}{side}) at unit {self.unit} (#{self.index})"
+        return f"rule {self.rule} ({RULES[self.rule]}{side}) at unit {self.unit} (point {self.index + 1} of the chart)"
 
 
 @dataclass(frozen=True)

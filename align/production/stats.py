@@ -405,8 +405,13 @@ def lot_statistics(rows: list[dict], spec: Spec | None = None, trend_by: str = "
                   + f" (e.g. {', '.join(who[:3])}); they do not count as passing"
                   for (key, figure, why), who in missing.items())
     spread = [x for x in xs.values() if math.isfinite(x)]
+    untimed = sorted({r["serial"] for r in rows if r.get("test_time") is None})
     if trend_by == "time" and spread and max(spread) == min(spread):
         notes += ("no trend over time: every unit has the same test time (the manifest's test_time, or the log's, "
                   "else when its row was made); give each unit its own, or trend over the lot's order",)
+    elif trend_by == "time" and untimed:
+        notes += (f"{len(untimed)} of {len(by_serial)} units have no test time (e.g. {', '.join(untimed[:3])}): the "
+                  "trend places them when their row was made, which is when the batch ran, not when they were tested; "
+                  "give test_time in the manifest (or logs that state it), or trend over the lot's order",)
     ordered = sorted(units, key=lambda u: (u.verdict == "pass", u.order, u.serial))
     return LotStats(figures, tuple(ordered), trend_by, spec, notes)

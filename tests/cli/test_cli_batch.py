@@ -310,7 +310,10 @@ def test_ctrl_c_keeps_the_units_done_and_says_so(small_lot, tmp_path, run_cli, m
     assert res.code == 130 and res.err == ("imu-align: interrupted; the units done are kept (results.parquet, units/): "
                                            "run the same command again to finish the rest\n")
     done = _table(tmp_path / "out")
-    assert len(done) == 3 and not (tmp_path / "out" / ".batch.lock").exists()
+    # the units running at Ctrl-C finish (workers ignore it): each result written has its row
+    written = sorted(p.name.split(".")[0] for p in (tmp_path / "out" / "units").glob("*.json"))
+    assert 3 <= len(done) < 8 and sorted(done.serial[done.status == "ok"]) == written
+    assert not (tmp_path / "out" / ".batch.lock").exists()
     monkeypatch.undo()
     res = run_cli("batch", lot.manifest, "--workers", 2, "--out", tmp_path / "out")
     ok_before = int((done.status == "ok").sum())

@@ -37,7 +37,7 @@ def test_the_moving_range_rule_and_the_signal_s_unit_name():
     assert [(s.index, s.unit, s.count) for s in mr] == [(6, "SN6", 1)]  # |2.0 - 0.1| and |0.0 - 2.0|, one episode
     assert chart.mr == pytest.approx(np.mean([0.1, 0.2, 0.15, 0.05, 0.1])) and chart.mr_ucl == pytest.approx(3.267 * chart.mr)
     assert chart.sigma == pytest.approx(chart.mr / 1.128) and chart.reference == 6
-    assert chart.first("1").describe() == "rule 1 (one point beyond 3 sigma, above) at unit SN6 (#6)"
+    assert chart.first("1").describe() == "rule 1 (one point beyond 3 sigma, above) at unit SN6 (point 7 of the chart)"
 
 
 def _run_length(rng, rules, length):

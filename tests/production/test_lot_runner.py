@@ -41,19 +41,31 @@ def test_a_worker_that_dies_costs_its_unit_only(tmp_path, monkeypatch, fork):
 
 
 def test_ctrl_c_in_the_middle_keeps_the_units_done(tmp_path):
+    """Workers ignore Ctrl-C: a unit running when it comes finishes and writes its result, so its row is kept too
+    (a new user found results without rows: the journal had been folded before the running units finished)."""
     tasks = _tasks(tmp_path, 10)
     run = BatchRun(total=10)
 
     def progress(done):
-        if done == 4:
+        if done == 3:
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
         with ProcessPool(2) as pool:
-            run_units(tasks, failing_worker, pool, tmp_path, progress=progress, run=run, window=2)
+            run_units(tasks, slow_worker, pool, tmp_path, progress=progress, run=run, window=4)
     table = pq.read_table(tmp_path / "results.parquet").to_pandas()  # the journal was folded on the way out
-    assert len(run.units()) == 4 and sorted(table.serial) == sorted(r["serial"] for r in run.units())
+    written = sorted(p.stem for p in (tmp_path / "units").glob("*.json"))
+    assert sorted(table.serial) == sorted(r["serial"] for r in run.units()) == written
+    assert 3 < len(written) < 10  # those running finished; those queued were dropped
     assert not (tmp_path / "results.parquet.journal").exists()
+
+
+def slow_worker(task: Task) -> list[dict]:
+    import time
+
+    time.sleep(0.3)
+    task.result.write_text("{}")
+    return unit_rows(task, 2, "imu-align: error: x: file not found", task.digest(), 0.3)
 
 
 def failing_worker(task: Task) -> list[dict]:

@@ -75,6 +75,9 @@ def test_the_trend_over_time_follows_the_test_time_not_when_the_rows_were_made(t
     got = lot_statistics(rows, read_spec(tmp_path / "s.toml"), "time")
     (fs,) = got.figures
     assert fs.slope == pytest.approx(1e-4) and fs.x[-1] == pytest.approx(39 / 4) and not got.notes
+    some = [{**r, "test_time": None} if k % 10 == 3 else r for k, r in enumerate(rows)]  # 4 units not dated: said
+    (note,) = lot_statistics(some, read_spec(tmp_path / "s.toml"), "time").notes
+    assert note.startswith("4 of 40 units have no test time (e.g. U13, U23, U3): the trend places them when")
     same = [{**r, "test_time": t0} for r in rows]  # every unit tested at one time: no trend, and said why
     got = lot_statistics(same, read_spec(tmp_path / "s.toml"), "time")
     assert math.isnan(got.figures[0].slope)
@@ -140,6 +143,7 @@ def test_device_id_and_test_time_from_the_log_where_the_manifest_gives_none(tmp_
     # the manifest wins; a log of another device id is said in the unit's message
     assert (c["device_id"], c["test_time"]) == ("999", datetime(2026, 5, 4, 10, 0, tzinfo=UTC))
     assert "the log states device id 2621474, the manifest 999" in c["message"] and not a["message"]
+    assert c["verdict"] == "warn" and "units passing with a warning (1):" in res.out and "C1  " in res.out
     assert load_result(tmp_path / "out" / "units" / "A1.allan.json").provenance.unit == {
         "serial": "A1", "device_id": "2424842", "test_time": first.isoformat()}
 
