@@ -25,6 +25,7 @@ from __future__ import annotations
 import difflib
 import enum
 import functools
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -336,11 +337,23 @@ def prepare_unit(unit, folder: Path, where: str, cache: dict | None = None) -> P
     return Prepared(options, {k: _plain(v) for k, v in params.items()} if asked else {}, _hashed(unit, files))
 
 
-def parse_rows(units, folder: Path, where: str) -> dict:
+class ParseCache(dict):
+    """The rows parsed, by their options words (:func:`_parsed`): the latest :attr:`SIZE` kept, so that a manifest
+    whose rows differ each (``{serial}`` in their options) does not keep one parse per unit."""
+
+    SIZE = 256
+
+    def __setitem__(self, key, value) -> None:
+        if key not in self and len(self) >= self.SIZE:
+            del self[next(iter(self))]
+        super().__setitem__(key, value)
+
+
+def parse_rows(units: Iterable, folder: Path, where: str) -> ParseCache:
     """Every unit's row parsed by its job's command (and its validation run's by ``verify``), rows with the same
     options words once: a row the command refuses is refused before any unit runs. The parse cache
-    :func:`task_maker` builds each unit's options from."""
-    cache: dict = {}
+    :func:`task_maker` builds each unit's options from (a row no longer in it is parsed again)."""
+    cache = ParseCache()
     for u in units:
         _parsed(u, folder, where, cache)
         if u.validation is not None:
@@ -365,12 +378,12 @@ def prepare_validation(unit, result: Path, folder: Path, where: str, cache: dict
     return options, None, tuple(Path(p) for p in files)
 
 
-def task_maker(folder: Path, cache: dict | None = None, where: str | None = None):
+def task_maker(folder: Path, cache: dict | None = None, where: str | None = None) -> Callable[[Any, Path, str], Any]:
     """``make(unit, result, run) -> Task``: the unit's job and options, built as the unit is taken
     (:func:`prepare_unit`, its row's parse from ``cache``): the options of a long lot are not all held at once."""
     from align.production import Task
 
-    cache = {} if cache is None else cache
+    cache = ParseCache() if cache is None else cache
 
     def make(unit, result: Path, run: str) -> Task:
         said = where or str(folder)

@@ -31,7 +31,10 @@ def gps_utc_us(week: np.ndarray, ms: np.ndarray) -> np.ndarray:
 
     Parameters
     ----------
-    week, ms : array_like, shape (n,)
+    week : array_like, shape (n,)
+        GPS weeks since 1980-01-06 (not rolled over at 1024).
+    ms : array_like, shape (n,)
+        Milliseconds since the start of the week (GPS time, no leap seconds).
 
     Returns
     -------

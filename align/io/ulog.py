@@ -43,7 +43,7 @@ from align.errors import InputError, literal
 from align.io.formats import LogFormat
 from align.io.readers import Columns, LogReader, Stream
 from align.io.ulog_format import Join, Layout, Scan, decode, match, sniff, tolerance
-from align.io.ulog_time import GPS, dated, utc_at_boot
+from align.io.ulog_time import GPS, Dating, dated, utc_at_boot
 
 __all__ = ["read", "describe", "iter_chunks", "sniff", "READER", "KINDS", "UNITS"]
 
@@ -296,9 +296,9 @@ class _Reader:
 
 def _open(path: Path, fmt: LogFormat, names: list[str] | None, time_column: str | None, keep: bool
           ) -> tuple[Scan, _Reader, dict[int, list[np.ndarray]]]:
-    """Scan a log (keeping the record offsets of the candidate topics when ``keep``); choose the stream."""
+    """Scan a log (the offsets of the candidate topics kept when ``keep``, the GPS fixes' always); choose the stream."""
     scan, where, starts = Scan(path), str(path), dict[int, list[np.ndarray]]()
-    wanted = _candidates(fmt.topic) | {GPS} if keep else set()
+    wanted = _candidates(fmt.topic) | {GPS} if keep else {GPS}
     for st, key in scan.windows():
         for k in np.unique(key).tolist():
             if scan.keys[k] in wanted:
@@ -331,9 +331,8 @@ def read(path: Path, names: list[str] | None, time_column: str | None, log_forma
     Returns
     -------
     Columns
-        ``data`` (n, len(names)); units, the stream read (``format``, ``topic``, ``instance``,
-        ``device_id``, and ``time_origin_utc_ns``, the first sample's UTC, when the log has a GPS fix's time) and
-        remarks (a truncated last message).
+        ``data`` (n, len(names)); units, the stream read (``format``, ``topic``, ``instance``, ``device_id``, and
+        ``time_origin_utc_ns``, the first sample's UTC, when the log has a GPS fix's time) and remarks.
     """
     scan, reader, starts = _open(path, log_format, names, time_column, keep=True)
     try:
@@ -354,20 +353,21 @@ def iter_chunks(path: Path, log_format: LogFormat, names: list[str] | None = Non
     Columns
         ``data`` (k, len(names)) float64, k <= rows.
     """
-    scan, reader, _ = _open(path, log_format, names, "time", keep=False)
+    scan, reader, gps = _open(path, log_format, names, "time", keep=False)
+    boot = utc_at_boot(scan, gps)
     scan.close()
     scan = reader.scan = Scan(path)
-    keys, block = {k for _, k, _ in reader.parts}, np.zeros((0, len(reader.names)))
+    keys, block, date = {k for _, k, _ in reader.parts}, np.zeros((0, len(reader.names))), Dating(boot)
     try:
         for st, key in scan.windows():
             block = np.concatenate([block, reader.piece({k: st[key == k] for k in keys}, final=False)])
             n = len(block) // rows * rows
             for s in range(0, n, rows):
-                yield reader.columns(block[s : s + rows], last=False)
+                yield date(reader.columns(block[s : s + rows], last=False))
             block = block[n:]
         block = np.concatenate([block, reader.piece({}, final=True)])
         for s in range(0, max(len(block), 1), rows):
-            yield reader.columns(block[s : s + rows], last=s + rows >= len(block))
+            yield date(reader.columns(block[s : s + rows], last=s + rows >= len(block)))
     finally:
         scan.close()
 

@@ -28,7 +28,7 @@ from __future__ import annotations
 import os
 import socket
 import time
-from collections.abc import Callable, Iterable, Iterator, Mapping
+from collections.abc import Callable, Collection, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -132,6 +132,7 @@ def result_unit_rows(task: Task, result, message: str, digest: str, seconds: flo
             for r in (found or [{"sensor": None, "verdict": "pass", "checks": ""}])]
     for r in rows if said else ():  # another device than the manifest's: a warning the batch's summary lists
         r["message"] = "; ".join(filter(None, [r.get("message"), said]))
+        r["checks"] = "; ".join(filter(None, [r.get("checks"), "identity: warn"]))  # judged again, still a warning
         r["verdict"] = "warn" if r["verdict"] == "pass" else r["verdict"]
     return rows
 
@@ -250,7 +251,8 @@ def plan_tasks(units: Iterable[Unit], out: Path, make: Callable[[Unit, Path, str
     Parameters
     ----------
     units : iterable of Unit
-        Iterated twice (their serials first): a :class:`~align.production.manifest.Manifest` or a sequence.
+        Iterated twice (their serials first): a :class:`~align.production.manifest.Manifest` or a sequence (any
+        other iterable is made a list).
     out : Path
         The output folder (holding ``units/`` and the table).
     make : callable
@@ -271,6 +273,7 @@ def plan_tasks(units: Iterable[Unit], out: Path, make: Callable[[Unit, Path, str
     ------
     Task
     """
+    units = units if isinstance(units, Collection) else list(units)  # iterated twice: a generator once
     table_path = out / TABLE
     Journal(table_path).recover()
     figures = list(figures)

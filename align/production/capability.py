@@ -33,19 +33,19 @@ of their Cpk_pct is the 95 % interval's lower end, and its upper end is the larg
 of a far-tail reading's bootstrap (each tail's lowest quantile at the 69 % point or beyond, :func:`far_step`;
 :func:`percentile_interval`). Only the order statistics the fit reads are drawn, exactly in
 distribution (:func:`bootstrap_quantiles`), so a resample costs the same at 100 as at 3,000 units. Measured over 200
-simulated lots per case (lognormal, gamma, a two-mode normal mixture at 100, 200, 300, 400, 1,000 and 3,000
-units; ``tests/production/test_capability_coverage.py``; two seeds) it covers the analytic truth in 97 to 100 % of
-lots, its lower end above the truth in at most 2.5 %. The far reading's top is there for the bimodal lot of 175 to
-400 units: the lot's own reading alone covered it in 79 to 95 % (300 units: 79 and 86 %), its tails' lowest
-quantiles in the mixture's valley, every miss below the truth (the estimate -15 %); the far reading alone covers it
-but biases every lot's Cpk low by 15 to 35 %, so it only raises the top (by 0 to 17 %, median), never the lower end
-a capability claim rests on. Reading each tail 5 units from the end at a fixed step undercovered large lots (83 to
-90 % at 3,000 skewed units, 88 to 92 % at 1,000 bimodal ones): the fit's bias then outgrew the interval. A type 7
-quantile ``k`` units from the end reads a tail of probability about ``(k + 1) / n``, not ``k / n`` (+20 % at
-``k = 5``: the 99.865 % point extrapolated low, Cpk +2 to +4 % on the lognormal lot), and a bimodal lot's lowest
-tail quantile fell in its valley; reading 12 units from the end at a step of 0.3 cuts both. Its width states
-honestly how little a lot says about a 0.135 % point (the lower end 35 to 50 % of Cpk below the estimate at 200
-units, 15 to 30 % at 1,000).
+simulated lots per case (lognormal, gamma, a two-mode normal mixture at 100, 200, 300, 400, 1,000 and 3,000 units;
+``tests/production/test_capability_coverage.py``; seeds 7, 8, 11, 12) it covers the analytic truth in 95.5 to 100 %
+of lots, its lower end above the truth in at most 4.5 % (3,000 skewed units, seed 11). The far reading's top is there
+for the bimodal lot of 175 to 400 units: the lot's own reading alone covered it in 79 to 95 % (300 units: 79 and
+86 %), its tails' lowest quantiles in the mixture's valley, every miss below the truth (the estimate -15 %); the far
+reading alone covers it but biases every lot's Cpk low by 15 to 35 %, so it only raises the top (by 0 to 17 %,
+median), never the lower end a capability claim rests on. Reading each tail 5 units from the end at a fixed step
+undercovered large lots (83 to 90 % at 3,000 skewed units, 88 to 92 % at 1,000 bimodal ones): the fit's bias then
+outgrew the interval. A type 7 quantile ``k`` units from the end reads a tail of probability about ``(k + 1) / n``,
+not ``k / n`` (+20 % at ``k = 5``: the 99.865 % point extrapolated low, Cpk +2 to +4 % on the lognormal lot), and a
+bimodal lot's lowest tail quantile fell in its valley; reading 12 units from the end at a step of 0.3 cuts both. Its
+width states honestly how little a lot says about a 0.135 % point (the lower end 35 to 50 % of Cpk below the
+estimate at 200 units, 15 to 30 % at 1,000).
 
 The decision
 ------------
@@ -240,9 +240,10 @@ def bootstrap_quantiles(sorted_values: np.ndarray, resamples: int, rng: np.rando
 
 
 def far_step(n: int) -> float:
-    """The step of the far-tail reading of a lot of ``n`` (:func:`percentile_interval`): at most :func:`tail_step`'s,
-    and small enough that a tail's lowest quantile is at normal score :data:`FAR_FLOOR` (the 69 % point) with its top
-    one ``k`` units from the end (:func:`tail_centre`).
+    """The step of the far-tail reading of a lot of ``n`` units (:func:`percentile_interval`): at most
+    :func:`tail_step`'s, the lowest quantile of a tail at normal score :data:`FAR_FLOOR` (the 69 % point), its top ``k``
+    units from the end (:func:`tail_centre`; below about 80 units its centre is held at 1: the lowest quantile lies
+    further out); 0 (no far reading) for a lot too small for one.
 
     >>> round(far_step(100), 3), round(far_step(300), 3), far_step(3000)
     (0.191, 0.271, 0.3)
@@ -250,7 +251,7 @@ def far_step(n: int) -> float:
     from scipy.special import ndtri
 
     k = float(np.clip(n / FROM_END_PER, *FROM_END))
-    return min(tail_step(n), float(ndtri(1 - k / max(n, k + 1)) - FAR_FLOOR) / 6)
+    return max(0.0, min(tail_step(n), float(ndtri(1 - k / max(n, k + 1)) - FAR_FLOOR) / 6))
 
 
 def percentile_interval(sorted_values: np.ndarray, low: float | None, high: float | None, resamples: int,
@@ -265,11 +266,15 @@ def percentile_interval(sorted_values: np.ndarray, low: float | None, high: floa
     Parameters
     ----------
     sorted_values : ndarray, shape (n,) or (L, n)
-        A lot (or L lots) sorted ascending.
+        A lot (or L lots) sorted ascending, in the figure's unit.
     low, high : float or None
+        The spec limits, the figure's unit (None: that side open).
     resamples : int
+        Bootstrap resamples of each reading.
     rng : numpy.random.Generator
+        Draws the lot's own reading's resamples, then the far reading's.
     level : float
+        The interval's confidence level.
 
     Returns
     -------
@@ -278,15 +283,15 @@ def percentile_interval(sorted_values: np.ndarray, low: float | None, high: floa
         The fraction of the lot's own reading's resamples with a finite Cpk (of all lots).
     """
     x = np.asarray(sorted_values, float)
-    n = x.shape[-1]
-    tail = 100 * (1 - level) / 2
-    boot = percentile_cpk(bootstrap_quantiles(x, resamples, rng), low, high)
-    step = far_step(n)
-    far = percentile_cpk(bootstrap_quantiles(x, resamples, rng, z0=tail_centre(n, step), step=step), low, high)
+    n, tail = x.shape[-1], 100 * (1 - level) / 2
+    boot, step = percentile_cpk(bootstrap_quantiles(x, resamples, rng), low, high), far_step(x.shape[-1])
     with warnings.catch_warnings():  # a lot whose every resample failed: NaN ends, said by ``valid``
         warnings.simplefilter("ignore", RuntimeWarning)
         lo, hi = np.nanpercentile(boot, [tail, 100 - tail], axis=-1)
-        hi = np.fmax(hi, np.nanpercentile(far, 100 - tail, axis=-1))
+        if step > 0:  # the far reading raises the top only where 95 % of its resamples could be fitted
+            far = percentile_cpk(bootstrap_quantiles(x, resamples, rng, z0=tail_centre(n, step), step=step), low, high)
+            usable = np.mean(np.isfinite(far), axis=-1) >= 0.95
+            hi = np.where(usable, np.fmax(hi, np.nanpercentile(far, 100 - tail, axis=-1)), hi)
     return np.array([lo, hi]), float(np.mean(np.isfinite(boot)))
 
 

@@ -132,9 +132,8 @@ class Manifest:
 
     def __iter__(self) -> Iterator[Unit]:
         """The units in the manifest's order (:func:`_make` of each checked row)."""
-        folder = self.path.resolve().parent
         plans: dict[str, Path] = {}
-        return (_make(order, row, folder, plans) for order, row in enumerate(self.rows))
+        return (_make(order, row, plans) for order, row in enumerate(self.rows))
 
     @property
     def units(self) -> tuple[Unit, ...]:
@@ -179,8 +178,15 @@ def read_manifest(path: str | Path, jobs: Mapping[str, str]) -> Manifest:
     rows: list[tuple] = []
     seen: dict[tuple[str, str], str] = {}
     shared: dict = {}
+    resolved: dict[str, str] = {}
+    folder = p.resolve().parent
     for row, record in records:
-        checked = tuple(shared.setdefault(v, v) for v in _checked(record, row, jobs, str(p)))
+        words = list(_checked(record, row, jobs, str(p)))
+        for k in (3, 4, 8, 9):  # log, plan and the validation's: resolved once, here (a plan once for the lot)
+            if words[k] and words[k] not in resolved:
+                resolved[words[k]] = str((folder / words[k]).resolve())
+            words[k] = resolved[words[k]] if words[k] else ""
+        checked = tuple(shared.setdefault(v, v) for v in words)
         serial, job = checked[1], checked[2]
         key = (serial.lower(), job)  # case-only differences collide on case-insensitive file systems
         if key in seen:
@@ -261,7 +267,7 @@ def _toml_records(path: Path) -> list[tuple[str, dict]]:
 def _checked(record: dict, row: str, jobs: Mapping[str, str], where: str) -> tuple:
     """A row checked, as the words a :class:`Unit` is made of: ``(row, serial, job, log, plan, options, slot,
     identity, validation, validation_plan, validation_options)`` (paths as written, relative to the manifest;
-    ``""`` when not given)."""
+    ``""`` when not given; :func:`read_manifest` resolves them)."""
     def bad(column: str, what: str) -> InputError:
         return InputError(f"{row}, column {column}: {what}", where)
 
@@ -307,16 +313,15 @@ def _words(record: dict, column: str, serial: str, bad) -> tuple[str, ...]:
         raise bad(column, f"cannot be split ({exc}); check the quotes") from None
 
 
-def _make(order: int, row: tuple, folder: Path, plans: dict[str, Path]) -> Unit:
-    """The :class:`Unit` of a checked row (:func:`_checked`), its paths resolved against ``folder`` (the plans,
-    often one for the whole lot, resolved once: ``plans``)."""
+def _make(order: int, row: tuple, plans: dict[str, Path]) -> Unit:
+    """The :class:`Unit` of a checked row (:func:`_checked`, its paths resolved by :func:`read_manifest`; the
+    plans, often one for the whole lot, made paths once: ``plans``)."""
     where, serial, job, log, plan, options, slot, identity, check, check_plan, checks = row
     for p in (plan, check_plan):
         if p and p not in plans:
-            plans[p] = (folder / p).resolve()
-    return Unit(serial, job, (folder / log).resolve(), plans[plan] if plan else None, options, slot, order, where,
-                identity, (folder / check).resolve() if check else None, plans[check_plan] if check_plan else None,
-                checks)
+            plans[p] = Path(p)
+    return Unit(serial, job, Path(log), plans[plan] if plan else None, options, slot, order, where, identity,
+                Path(check) if check else None, plans[check_plan] if check_plan else None, checks)
 
 
 def _identity(record: dict, bad) -> tuple[tuple[str, str], ...]:

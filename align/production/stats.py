@@ -250,7 +250,8 @@ def judge_rows(rows: list[dict], spec: Spec | None) -> list[dict]:
     out = []
     for r in rows:
         broken = _violations(r, spec) if r.get("status") == "ok" else []
-        out.append({**r, "verdict": "fail", "message": "outside the spec: " + "; ".join(broken)} if broken else r)
+        said = "; ".join(filter(None, [r.get("message"), "outside the spec: " + "; ".join(broken)]))
+        out.append({**r, "verdict": "fail", "message": said} if broken else r)
     return out
 
 
@@ -260,8 +261,10 @@ def rejudge_rows(rows: list[dict], spec: Spec | None) -> list[dict]:
     fresh = []
     for r in rows:
         if r.get("verdict") == "fail" and "figures of merit: " not in (r.get("checks") or ""):
+            said = r.get("message") or ""
+            cut = said.find("outside the spec: ")  # the spec's part, last (judge_rows): what came before stays
             r = {**r, "verdict": "warn" if ": warn" in (r.get("checks") or "") else "pass",
-                 "message": "" if (r.get("message") or "").startswith("outside the spec") else r.get("message")}
+                 "message": said[:cut].rstrip("; ") if cut >= 0 else said}
         fresh.append(r)
     return judge_rows(fresh, spec)
 
@@ -406,7 +409,7 @@ def lot_statistics(rows: list[dict], spec: Spec | None = None, trend_by: str = "
                   for (key, figure, why), who in missing.items())
     spread = [x for x in xs.values() if math.isfinite(x)]
     untimed = sorted({r["serial"] for r in rows if r.get("test_time") is None})
-    if trend_by == "time" and spread and max(spread) == min(spread):
+    if trend_by == "time" and len(by_serial) > 1 and spread and max(spread) == min(spread):
         notes += ("no trend over time: every unit has the same test time (the manifest's test_time, or the log's, "
                   "else when its row was made); give each unit its own, or trend over the lot's order",)
     elif trend_by == "time" and untimed:

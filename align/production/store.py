@@ -235,7 +235,7 @@ def _lines(fh) -> Iterable[dict]:
             continue
 
 
-def _indices(at: list[int]) -> pa.Array:
+def _indices(at) -> pa.Array:
     """Row indices as an Arrow array, from their bytes (``pa.array`` of a list imports pandas: 0.2 s, 55 MB)."""
     import numpy as np
 
@@ -243,15 +243,47 @@ def _indices(at: list[int]) -> pa.Array:
     return pa.Array.from_buffers(pa.int64(), len(idx), [None, pa.py_buffer(idx)])
 
 
+def _codes(indices: pa.Array, null: int):
+    """A dictionary's integer indices as numpy, from their bytes (``to_numpy`` imports pandas), ``null`` for a null."""
+    import numpy as np
+
+    codes = np.frombuffer(indices.buffers()[1], dtype=f"<i{indices.type.bit_width // 8}")
+    codes = codes[indices.offset : indices.offset + len(indices)].astype(np.int64)
+    if indices.null_count:  # none is written (serial is required); a foreign part's, read as none of the lot
+        valid = np.unpackbits(np.frombuffer(indices.buffers()[0], np.uint8), bitorder="little")
+        codes[valid[indices.offset : indices.offset + len(indices)] == 0] = null
+    return codes
+
+
 class LatestRuns:
     """A resume's view of a store (:func:`align.production.batch.plan_tasks`): the latest run of each (serial,
     job) of a lot (:func:`align.production.table.latest_rows`), kept as Arrow columns: a row becomes a dict only
-    when a unit is skipped."""
+    when a unit is skipped.
+
+    Parameters
+    ----------
+    table : pyarrow.Table
+        The store's rows (:func:`read_table`, META and ``figures`` at least).
+    serials : set of str
+        The lot's serials: the store's other rows (other lots, a line's years) are left out without being made
+        Python objects (the serial column dictionary-encoded, its distinct values tested).
+    figures : list of str
+        The figures a skipped unit's rows carry.
+
+    Attributes
+    ----------
+    at : dict of (str, str) -> list of int
+        The rows of the latest run of each (serial, job), as indices into the kept table.
+    """
 
     def __init__(self, table: pa.Table, serials: set[str], figures: list[str]) -> None:
+        import numpy as np
+
         if table.num_rows:  # the manifest's serials alone (a store holds every lot a line ran)
-            keep = [i for i, s in enumerate(table.column("serial").to_pylist()) if s in serials]
-            table = table.take(_indices(keep))
+            coded = table.column("serial").combine_chunks().dictionary_encode()
+            known = np.array([v in serials for v in coded.dictionary.to_pylist()] + [False])
+            codes = _codes(coded.indices, len(known) - 1)
+            table = table.take(_indices(np.flatnonzero(known[codes])))
         keys = zip(table.column("serial").to_pylist(), table.column("job").to_pylist(),
                    table.column("time").cast(pa.int64()).to_pylist(), table.column("run").to_pylist())
         best: dict[tuple[str, str], tuple[int, str, list[int]]] = {}
@@ -261,15 +293,19 @@ class LatestRuns:
                 best[(serial, job)] = (stamp, run, [i])
             elif stamp == have[0] and run == have[1]:
                 have[2].append(i)
+        latest = [i for v in best.values() for i in v[2]]  # only the latest runs kept, renumbered
+        table, where = table.take(_indices(latest)), {i: k for k, i in enumerate(latest)}
         self.table, self.figures = table, figures
-        self.at = {k: v[2] for k, v in best.items()}
+        self.at = {k: [where[i] for i in v[2]] for k, v in best.items()}
         status, digest = table.column("status").to_pylist(), table.column("input_hash").to_pylist()
         self.first = {k: (status[v[0]], digest[v[0]]) for k, v in self.at.items()}
 
     def status(self, serial: str, job: str) -> str | None:
+        """The status of (serial, job)'s latest run (None: none in the store)."""
         return self.first.get((serial, job), (None, None))[0]
 
     def input_hash(self, serial: str, job: str) -> str | None:
+        """The content hash of (serial, job)'s latest run's inputs (None: none in the store)."""
         return self.first.get((serial, job), (None, None))[1]
 
     def rows(self, at: list[int]) -> list[dict]:

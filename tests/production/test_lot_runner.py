@@ -156,3 +156,21 @@ def test_a_rerun_skips_the_units_done_with_unchanged_inputs_and_leaves_no_thread
     made.clear()
     lazy = plan_tasks([t.unit for t in tasks], tmp_path, make, "run1", rerun=True, chunk=2)
     assert next(lazy).unit.serial == "U0" and made == ["U0", "U1"]
+
+
+def test_a_resume_keeps_the_latest_run_of_the_lot_s_serials_only(tmp_path):
+    from datetime import UTC, datetime
+
+    from align.production.store import LatestRuns, append_rows, read_table
+
+    def row(serial, run, day, status="ok"):
+        return {"serial": serial, "job": "allan", "run": run, "time": datetime(2026, 3, day, tzinfo=UTC),
+                "status": status, "input_hash": f"{serial}{run}", "order": 0}
+
+    store = tmp_path / "results.parquet"
+    append_rows(store, [row("A", "r1", 1), row("B", "r1", 1), row("X", "r1", 1)])  # X: another lot's unit
+    append_rows(store, [row("A", "r2", 2, "failed"), row("X", "r2", 2)])
+    last = LatestRuns(read_table(store), {"A", "B"}, [])
+    assert set(last.at) == {("A", "allan"), ("B", "allan")} and last.table.num_rows == 2
+    assert (last.status("A", "allan"), last.input_hash("A", "allan")) == ("failed", "Ar2")
+    assert last.status("X", "allan") is None and [r["run"] for r in last.rows(last.at[("B", "allan")])] == ["r1"]

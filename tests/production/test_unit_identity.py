@@ -181,3 +181,32 @@ def test_an_euroc_folder_of_epoch_stamps_dates_its_unit(tmp_path, run_cli):
     assert res.code == 0, res.err + res.out
     (row,) = latest_rows(read_table(tmp_path / "out" / "results.parquet"))
     assert row["test_time"] == datetime(2014, 6, 24, 19, 2, 59, 758555, tzinfo=UTC) and row["device_id"] is None
+
+
+def test_the_device_id_remark_survives_a_spec_and_a_rejudge(tmp_path):
+    from align.production import read_spec
+    from align.production.stats import judge_rows, rejudge_rows
+
+    (tmp_path / "tight.toml").write_text('scale_x = { min = 0.999, max = 1.001 }\n')
+    said = "the log states device id 2621474, the manifest 999: is it the unit's log?"
+    row = {"serial": "C1", "job": "allan", "status": "ok", "sensor": "gyroscope", "verdict": "warn",
+           "checks": "identity: warn", "message": said, "scale_x": 1.01}
+    (failed,) = judge_rows([row], read_spec(tmp_path / "tight.toml"))
+    assert failed["verdict"] == "fail" and failed["message"].startswith(said + "; outside the spec: scale_x")
+    (again,) = rejudge_rows([failed], None)  # judged again without the spec: the warning and its remark are back
+    assert (again["verdict"], again["message"]) == ("warn", said)
+
+
+def test_a_long_ulog_read_in_blocks_is_dated_like_one_read_whole(tmp_path):
+    # a log of 200 MB or more is read in blocks (align.io.ulog.iter_chunks): every block dated by the stream's first
+    # sample, as the whole read is
+    from align.io import ulog
+    from align.io.formats import LogFormat
+
+    boot = int(datetime(2026, 5, 4, 7, 30, 0, tzinfo=UTC).timestamp() * 1e6)
+    path = _ulog(tmp_path / "a.ulg", 2424842, boot, seconds=30.0)
+    fmt = LogFormat(topic="sensor_gyro:0")
+    whole = ulog.read(path, None, "time", fmt).source["time_origin_utc_ns"]
+    blocks = list(ulog.iter_chunks(path, fmt, None, rows=700))
+    assert len(blocks) > 3 and {b.source["time_origin_utc_ns"] for b in blocks} == {whole}
+    assert whole == int(datetime(2026, 5, 4, 7, 30, 5, tzinfo=UTC).timestamp()) * 10**9
