@@ -17,7 +17,8 @@ against the model refitted without it, chi-bar-square p-values, Holm's step-down
 ramp that fails leaves the model, a noise term that fails stays in it unclaimed). The ramp's cross terms with
 every noise term (white, flicker, random walk, quantization) are in the covariance (:mod:`align.noise.covariance`).
 The covariance of ``p`` is ``(A' S^-1 A)^-1`` on the kept terms, scaled by ``chi2 / dof`` when above 1 (a curve
-the model does not describe), and a parameter's 1-sigma is ``sigma(p_k) / (2 sqrt(p_k))``.
+the model does not describe; the ramp's variance at least that with the unclaimed noise terms at their upper values,
+:mod:`align.noise.gls`), and a parameter's 1-sigma is ``sigma(p_k) / (2 sqrt(p_k))``.
 
 A term is identifiable when Holm's test claims it, it is at least 30 % of the model at some fitted tau,
 and it is known to 25 % (1-sigma). Otherwise the fit gives its one-sided 95 % upper bound (the largest value
