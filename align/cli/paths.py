@@ -212,11 +212,7 @@ def write_run(json_out: Path | None, result, files: Iterable[tuple[Path, bytes |
     with outputs() as out:
         if json_out is not None:
             out.write_json(json_out, result)
-        for path, data in files:
-            if isinstance(data, bytes):
-                out.write_bytes(path, data)
-            else:
-                out.write_text(path, data)
+        out.write_files(files)
 
 
 def judged_outcome(result) -> None:

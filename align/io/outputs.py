@@ -26,7 +26,7 @@ from __future__ import annotations
 import json
 import os
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import IO
 
@@ -130,6 +130,11 @@ class Outputs:
         if hasattr(data, "to_dict"):
             data = data.to_dict()
         return self.write_text(path, json.dumps(to_json_value(data), indent=2) + "\n")
+
+    def write_files(self, files: Iterable[tuple[str | Path, bytes | str]]) -> list[Path]:
+        """Stage each ``(path, data)``: bytes as they are, text as UTF-8 (a job's extra output files)."""
+        return [self.write_bytes(path, data) if isinstance(data, bytes) else self.write_text(path, data)
+                for path, data in files]
 
     def write_csv(self, path: str | Path, names: list[str], data: np.ndarray) -> Path:
         """Stage numeric columns as CSV (pyarrow's writer, full float precision)."""

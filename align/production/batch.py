@@ -213,11 +213,7 @@ def _run(name: str, options: Any, path: Path, unit: Unit, files: Callable | None
         result = result.replace(provenance=replace(result.provenance, unit={"serial": unit.serial, **ident}))
         with Outputs() as out:  # all or none
             out.write_json(path, result)
-            for where, data in extra:
-                if isinstance(data, bytes):
-                    out.write_bytes(where, data)
-                else:
-                    out.write_text(where, data)
+            out.write_files(extra)
     return result
 
 

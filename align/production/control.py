@@ -150,7 +150,7 @@ def control_chart(values: np.ndarray, units: tuple | list | None = None, *, cent
     --------
     >>> x = np.r_[np.tile([0.1, -0.1], 20), [0.9, 1.1, 0.9, 1.2]]
     >>> [s.describe() for s in control_chart(x).signals][0]
-    'rule 1 (one point beyond 3 sigma, above) at unit 40 (#40)'
+    'rule 1 (one point beyond 3 sigma, above) at unit 40 (point 41 of the chart)'
     """
     x = np.asarray(values, float)
     n = len(x)
