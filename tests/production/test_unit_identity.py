@@ -121,6 +121,7 @@ def _ulog(path, device: int, utc_boot_us: int | None, seconds: float = 120.0, fs
     return path
 
 
+@pytest.mark.slow
 def test_device_id_and_test_time_from_the_log_where_the_manifest_gives_none(tmp_path, run_cli):
     from align.results import load_result
 
@@ -162,6 +163,7 @@ def test_a_clock_since_power_on_dates_nothing():
     assert log_identity(runs, now) == {"device_id": "7"}
 
 
+@pytest.mark.slow
 def test_an_euroc_folder_of_epoch_stamps_dates_its_unit(tmp_path, run_cli):
     # an ASL (EuRoC) dataset's data.csv: "#timestamp [ns]" since 1970 (MH_01_easy's first stamp: 2014-06-24)
     import numpy as np
