@@ -34,6 +34,7 @@ from align.errors import InputError, literal
 from align.io.dataflash_format import Layout, decode, field_units, scan
 from align.io.dataflash_format import sniff as _sniff
 from align.io.formats import LogFormat
+from align.io.gpstime import dated
 from align.io.readers import Columns, LogReader, Stream
 
 __all__ = ["read", "describe", "sniff", "READER", "COLUMNS"]
@@ -227,11 +228,9 @@ def read(path: Path, names: list[str] | None, time_column: str | None, log_forma
     for j, n in enumerate(wanted):
         label, _, factor = columns[n]
         np.multiply(raw[label], factor, out=data[j])
-    source = {"format": "dataflash", "topic": "IMU", "instance": imu.instance}
-    boot = _utc_at_boot(log)
-    if boot is not None and "time" in wanted and len(imu.positions):  # the first sample's UTC, from the GPS
-        source["time_origin_utc_ns"] = int(boot + round(float(data[wanted.index("time"), 0]) * 1e6)) * 1000
-    return Columns(wanted, data.T, {n: columns[n][1] for n in wanted}, source, log.notes())
+    got = Columns(wanted, data.T, {n: columns[n][1] for n in wanted},
+                  {"format": "dataflash", "topic": "IMU", "instance": imu.instance}, log.notes())
+    return dated(got, _utc_at_boot(log)) if "time" in wanted else got  # the first sample's UTC, from the GPS
 
 
 def _utc_at_boot(log: _Log) -> int | None:

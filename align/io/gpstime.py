@@ -6,7 +6,7 @@ GPS time counts from 1980-01-06T00:00:00Z without leap seconds; UTC has had leap
 
 Public names
 ------------
-gps_utc_us, LEAP, GPS_EPOCH_US
+gps_utc_us, dated, Dating, LEAP, GPS_EPOCH_US
 """
 
 from __future__ import annotations
@@ -15,7 +15,9 @@ from datetime import UTC, datetime
 
 import numpy as np
 
-__all__ = ["gps_utc_us", "LEAP", "GPS_EPOCH_US"]
+from align.io.readers import Columns
+
+__all__ = ["gps_utc_us", "dated", "Dating", "LEAP", "GPS_EPOCH_US"]
 
 #: 1980-01-06T00:00:00Z in microseconds since 1970
 GPS_EPOCH_US = int(datetime(1980, 1, 6, tzinfo=UTC).timestamp()) * 1_000_000
@@ -54,3 +56,31 @@ def gps_utc_us(week: np.ndarray, ms: np.ndarray) -> np.ndarray:
         utc = gps - offset * 1_000_000
         out = np.where(utc >= int(since.timestamp()) * 1_000_000, utc, out)
     return out
+
+
+def dated(got: Columns, boot_us: int | None, first_s: float | None = None) -> Columns:
+    """``got`` with its stream's first sample's UTC (ns since 1970) as ``source["time_origin_utc_ns"]``, when the
+    log's clock is tied to UTC (``boot_us``, :func:`utc_at_boot`) and a time column was read (else ``got`` as it is).
+
+    ``first_s``: the stream's first sample's time (s since power-on) when ``got`` is a later block of it; by default
+    ``got``'s own first.
+    """
+    if first_s is None and "time" in got.names and len(got.data):
+        first_s = float(got.data[0, got.names.index("time")])
+    if boot_us is None or first_s is None:
+        return got
+    at = (boot_us + round(first_s * 1e6)) * 1000
+    return Columns(got.names, got.data, got.units, {**got.source, "time_origin_utc_ns": int(at)}, got.notes)
+
+
+class Dating:
+    """Blocks of one stream dated alike (:func:`dated`): by the first sample of the first block with one."""
+
+    def __init__(self, boot_us: int | None) -> None:
+        self.boot_us = boot_us
+        self.first_s: float | None = None
+
+    def __call__(self, got: Columns) -> Columns:
+        if self.first_s is None and "time" in got.names and len(got.data):
+            self.first_s = float(got.data[0, got.names.index("time")])
+        return dated(got, self.boot_us, self.first_s)
