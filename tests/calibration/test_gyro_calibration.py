@@ -46,18 +46,18 @@ def test_truth_in_the_accelerometer_frame_is_upper_triangular_and_the_same_physi
 
 
 @pytest.mark.slow
-def test_gyro_m_within_its_3_sigma_over_24_seeds():
-    """All nine elements of M inside 3 sigma in at least 23 of 24 sessions (normal: ~97.6 % for nine), and the
-    1-sigma not padded: the normalised errors have an rms near 1."""
+def test_gyro_m_within_its_3_sigma_over_16_seeds():
+    """All nine elements of M inside 3 sigma in at least 15 of 16 sessions (normal: ~97.6 % for nine), and the
+    1-sigma not padded: the normalised errors have an rms near 1 (24 seeds before: CI's time)."""
     inside, z_all = 0, []
-    for seed in range(24):
+    for seed in range(16):
         run, _, g_acc, _ = _session(seed)
         got = calibrate_gyro_session(run.t, run.acc, run.gyr, "m/s^2", "rad/s").gyroscope
         z = (got.M - g_acc) / got.sigma_M
         inside += bool(np.abs(z).max() < 3)
         z_all.append(z.ravel())
         assert np.abs(got.bias - run.b_g).max() < 4 * got.sigma_bias.max()
-    assert inside >= 23, inside
+    assert inside >= 15, inside
     rms = float(np.sqrt(np.mean(np.square(z_all))))
     assert 0.6 < rms < 1.3, rms  # about 0.8: the propagated direction errors are partly in the residuals too
 

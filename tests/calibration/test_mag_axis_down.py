@@ -38,7 +38,7 @@ def test_recovered_within_3_sigma_over_many_seeds():
     """Full and half turns, sphere and hemisphere tumbles, 0.3 and 1 uT noise; and short tumbles with long
     turns, where the soft iron's uncertainty (propagated from the calibration's covariance) matters."""
     z, z_turns_only = [], []
-    for seed in range(120):
+    for seed in range(72):  # every combination of coverage, arc, noise and sizes 6 times (120 before: CI's time)
         cov_kind = ("sphere", "hemisphere")[seed % 2]
         arc = (360.0, 180.0)[(seed // 2) % 2]
         noise = (0.3e-6, 1.0e-6)[(seed // 4) % 2]

@@ -84,9 +84,10 @@ def test_a_skewed_lot_of_3000_is_covered():
 
 @pytest.mark.slow
 def test_percentile_cpk_coverage_skewed_and_bimodal_from_100_to_3000():
-    """200 lots per case; measured 0.965-1.0 (capability.py's module docstring). 200 to 400 units: with the lot's own
-    reading alone, the bimodal lot was covered in 0.79-0.95, every miss below the truth."""
-    got = {(name, n): _coverage(name, n) for name in CASES for n in (100, 200, 300, 400, 1000, 3000)}
+    """200 lots per case; measured 0.955-1.0 (capability.py's module docstring; 200 and 400 units too, measured, left
+    out for CI's time). 300 units: with the lot's own reading alone, the bimodal lot was covered in 0.79-0.86, every
+    miss below the truth."""
+    got = {(name, n): _coverage(name, n) for name in CASES for n in (100, 300, 1000, 3000)}
     bad = {k: v for k, v in got.items() if v[1] < 0.93 or v[3] > 0.05}  # 200 lots: a standard error of about 1.5 %
     assert not bad, bad
 
